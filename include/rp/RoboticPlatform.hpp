@@ -1,0 +1,8 @@
+#pragma once
+/// @file rp/RoboticPlatform.hpp
+/// Umbrella header: everything a Robotic Platform program uses, in namespace `rp`.
+///
+/// Programs written as in the paper include `"RoboticPlatform.hpp"` instead, which also brings
+/// the names into the global namespace.
+
+#include "rp/math/Math.hpp"
