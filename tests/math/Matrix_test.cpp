@@ -72,6 +72,31 @@ TEST(Matrix, ProductMatchesScalarLoops) {
   }
 }
 
+TEST(Matrix, ProductAssignedToOneOfItsFactorsIsStillCorrect) {
+  // Assignment writes products straight into the target unless the target is a factor.
+  std::mt19937_64 rng(8);
+  Matrix<4, 4> a, b;
+  fillRandom(a, rng);
+  fillRandom(b, rng);
+  const Eigen::Matrix4d ea = a, eb = b;
+  Matrix<4, 4> c;
+  c = a * b;
+  EXPECT_TRUE(c.isApprox(ea * eb, 1e-15));
+  a = a * b;
+  EXPECT_TRUE(a.isApprox(ea * eb, 1e-15));
+  b = a * b;
+  EXPECT_TRUE(b.isApprox(ea * eb * eb, 1e-15));
+  Matrix<4, 4> d = b;
+  d = d.transpose() * d;  // a factor that is an expression of the target
+  EXPECT_TRUE(d.isApprox(Eigen::Matrix4d(b.transpose()) * Eigen::Matrix4d(b), 1e-15));
+  MatrixX<> x(9, 9), y(9, 9);
+  fillRandom(x, rng);
+  fillRandom(y, rng);
+  const Eigen::MatrixXd ex = x, ey = y;
+  x = x * y;  // dynamic sizes take Eigen's general product
+  EXPECT_TRUE(x.isApprox(ex * ey, 1e-14));
+}
+
 TEST(Matrix, SumDifferenceScalarMultiplicationAndDivision) {
   Matrix<2, 2> a{{1, 2}, {3, 4}};
   Matrix<2, 2> b{{5, 6}, {7, 8}};

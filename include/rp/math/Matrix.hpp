@@ -168,6 +168,26 @@ class Matrix : public Eigen::Matrix<T, Rows, Cols, internal::storageOptions(Rows
     return *this;
   }
 
+  /// Assigns a matrix product. When both factors are plain matrices other than this one, the
+  /// product is written straight into this matrix; otherwise (`a = a * b`) through a temporary, as
+  /// Eigen does by default. Real-time safe: yes for fixed and bounded sizes.
+  template <typename Lhs, typename Rhs, int Option>
+  Matrix& operator=(const Eigen::Product<Lhs, Rhs, Option>& product) {
+    checked(product);
+    if constexpr (isPlain<Lhs>() && isPlain<Rhs>()) {
+      if (product.lhs().data() != Base::data() && product.rhs().data() != Base::data()) {
+        if constexpr (isSmallFixed<Lhs>() && isSmallFixed<Rhs>()) {
+          Base::noalias() = product.lhs().lazyProduct(product.rhs());  // coefficient-wise, unrolled
+        } else {
+          Base::noalias() = product;
+        }
+        return *this;
+      }
+    }
+    Base::operator=(product);
+    return *this;
+  }
+
   /// Starts a comma assignment: `v = 0, 45, -90, 0, 0, 0;` sets all elements, row by row.
   /// @throws MathException when the statement gives fewer or more values than the matrix has.
   internal::CommaAssigner<Matrix> operator=(const T& first) { return internal::CommaAssigner<Matrix>(*this, first); }
@@ -285,6 +305,17 @@ class Matrix : public Eigen::Matrix<T, Rows, Cols, internal::storageOptions(Rows
   }
 
  private:
+  template <typename X>
+  static constexpr bool isPlain() {
+    using D = std::remove_cv_t<std::remove_reference_t<X>>;
+    return std::is_base_of_v<Eigen::PlainObjectBase<D>, D>;
+  }
+  template <typename X>
+  static constexpr bool isSmallFixed() {
+    using D = std::remove_cv_t<std::remove_reference_t<X>>;
+    return D::RowsAtCompileTime != Dynamic && D::ColsAtCompileTime != Dynamic && D::RowsAtCompileTime <= 8 &&
+           D::ColsAtCompileTime <= 8;
+  }
   template <typename Other>
   static const Other& checked(const Eigen::EigenBase<Other>& other) {
     static_assert(Rows == Dynamic || Other::RowsAtCompileTime == Dynamic || Rows == int(Other::RowsAtCompileTime),
