@@ -33,17 +33,22 @@ constexpr int storageOptions(int rows, int cols) {
          ((rows == 1 && cols != 1) ? Eigen::RowMajor : Eigen::ColMajor);
 }
 
+// Out-of-line throwers for the paper's 1-based accessors (src/math/MatrixErrors.cpp).
+[[noreturn]] void throwIndexError(const char* where, Eigen::Index row, Eigen::Index col, Eigen::Index rows,
+                                  Eigen::Index cols);
+[[noreturn]] void throwVectorIndexError(const char* where, Eigen::Index i, Eigen::Index size);
+[[noreturn]] void throwBlockError(const char* where, Eigen::Index row, Eigen::Index col, Eigen::Index r,
+                                  Eigen::Index c, Eigen::Index rows, Eigen::Index cols);
+[[noreturn]] void throwSizeError(const char* where, Eigen::Index rows, Eigen::Index cols, int fixedRows,
+                                 int fixedCols, Eigen::Index maxRows, Eigen::Index maxCols);
+
 // Throws unless a run-time size fits a compile-time size.
-inline void checkSize(const char* where, Eigen::Index rows, Eigen::Index cols, int fixedRows,
-                      int fixedCols, Eigen::Index maxRows, Eigen::Index maxCols) {
+inline void checkSize(const char* where, Eigen::Index rows, Eigen::Index cols, int fixedRows, int fixedCols,
+                      Eigen::Index maxRows, Eigen::Index maxCols) {
   const bool rowsOk = fixedRows == Dynamic ? (maxRows == Dynamic || rows <= maxRows) : rows == fixedRows;
   const bool colsOk = fixedCols == Dynamic ? (maxCols == Dynamic || cols <= maxCols) : cols == fixedCols;
-  if (!rowsOk || !colsOk) {
-    throw MathException(std::string(where) + ": a " + std::to_string(rows) + "x" + std::to_string(cols) +
-                        " value does not fit a matrix of " +
-                        (fixedRows == Dynamic ? std::string("up to ") + std::to_string(maxRows) : std::to_string(fixedRows)) +
-                        "x" +
-                        (fixedCols == Dynamic ? std::string("up to ") + std::to_string(maxCols) : std::to_string(fixedCols)));
+  if (!rowsOk || !colsOk) [[unlikely]] {
+    throwSizeError(where, rows, cols, fixedRows, fixedCols, maxRows, maxCols);
   }
 }
 
@@ -329,25 +334,18 @@ class Matrix : public Eigen::Matrix<T, Rows, Cols, internal::storageOptions(Rows
     return other.derived();
   }
   void checkIndex(const char* where, int row, int col) const {
-    if (row < 1 || row > Base::rows() || col < 1 || col > Base::cols()) {
-      throw MathException(std::string("Matrix::") + where + ": element (" + std::to_string(row) + ", " +
-                          std::to_string(col) + ") is outside a " + std::to_string(Base::rows()) + "x" +
-                          std::to_string(Base::cols()) + " matrix (indices count from 1)");
+    if (row < 1 || row > Base::rows() || col < 1 || col > Base::cols()) [[unlikely]] {
+      internal::throwIndexError(where, row, col, Base::rows(), Base::cols());
     }
   }
   void checkVectorIndex(const char* where, int i) const {
-    if (i < 1 || i > Base::size()) {
-      throw MathException(std::string("Matrix::") + where + ": element " + std::to_string(i) +
-                          " is outside a vector of " + std::to_string(Base::size()) +
-                          " elements (indices count from 1)");
+    if (i < 1 || i > Base::size()) [[unlikely]] {
+      internal::throwVectorIndexError(where, i, Base::size());
     }
   }
   void checkBlock(const char* where, int row, int col, Eigen::Index r, Eigen::Index c) const {
-    if (row < 1 || col < 1 || row - 1 + r > Base::rows() || col - 1 + c > Base::cols()) {
-      throw MathException(std::string("Matrix::") + where + ": a " + std::to_string(r) + "x" + std::to_string(c) +
-                          " block at (" + std::to_string(row) + ", " + std::to_string(col) + ") is outside a " +
-                          std::to_string(Base::rows()) + "x" + std::to_string(Base::cols()) +
-                          " matrix (indices count from 1)");
+    if (row < 1 || col < 1 || row - 1 + r > Base::rows() || col - 1 + c > Base::cols()) [[unlikely]] {
+      internal::throwBlockError(where, row, col, r, c, Base::rows(), Base::cols());
     }
   }
 };
