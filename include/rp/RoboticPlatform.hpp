@@ -6,3 +6,5 @@
 /// the names into the global namespace.
 
 #include "rp/math/Math.hpp"
+#include "rp/core/Core.hpp"
+#include "rp/rt/RealTime.hpp"

@@ -1,0 +1,215 @@
+#pragma once
+/// @file
+/// The base class of every robotic object (paper section 3.2, Figure 5).
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rp/core/Configuration.hpp"
+
+namespace rp {
+
+class ControlProgram;
+
+/// What a GUI field shows or edits.
+enum class FieldKind {
+  Number,   ///< one number
+  Vector,   ///< `size` numbers
+  Boolean,  ///< on/off
+  Text,     ///< a string
+  Choice,   ///< one of `choices`
+};
+
+/// One field of an object's control panel: plain data a GUI can render.
+struct ControlPanelField {
+  std::string name;                  ///< identifier, e.g. `kp`; for tunable fields the parameter name
+  std::string label;                 ///< text shown to the user
+  FieldKind kind = FieldKind::Number;  ///< what the field holds
+  int size = 1;                      ///< number of values (Vector)
+  std::string unit;                  ///< unit, e.g. `rad`, `N m`
+  double min = 0;                    ///< lower limit of the range (Number, Vector)
+  double max = 0;                    ///< upper limit of the range; min == max means unbounded
+  bool tunable = false;              ///< true: editable (a ControlProgram parameter); false: read-only
+  int stateIndex = -1;               ///< index of the first value in StateSnapshot::values, or -1
+  std::vector<std::string> choices;  ///< the words of a Choice field
+};
+
+/// An object's control panel (paper Figure 18): a title and fields.
+struct ControlPanel {
+  std::string title;                     ///< panel title
+  std::vector<ControlPanelField> fields;  ///< fields in display order
+};
+
+/// Capacity of StateSnapshot::values.
+inline constexpr int kMaxStateValues = 128;
+
+/// A fixed-size copy of an object's state, published by its servo thread without blocking and
+/// read by the GUI (see TripleBuffer). Trivially copyable.
+struct StateSnapshot {
+  double time = 0;           ///< clock time of the cycle that published it [s]
+  std::uint64_t cycle = 0;   ///< cycle number
+  int size = 0;              ///< number of valid entries in `values`
+  double values[kMaxStateValues] = {};  ///< values laid out as the control panel's stateIndex says
+};
+
+/// Error status of an object: 0 means no error.
+struct ErrorStatus {
+  int code = 0;         ///< 0: no error; otherwise an object-specific code
+  std::string message;  ///< what went wrong
+};
+
+/// An interactive command of an object (e.g. "Open Gripper"), listed by the GUI in its pop-up menu.
+struct CommandInfo {
+  std::string name;         ///< command name, used to invoke it
+  std::string description;  ///< one line for a tooltip
+};
+
+/// Name and class of a live object: an entry of the object list.
+struct ObjectInfo {
+  std::string name;       ///< object name
+  std::string className;  ///< class name as registered in the type database
+  bool physical = false;  ///< derived from PhysicalObject
+  bool hasControlLoop = false;  ///< runs a ControlProgram
+};
+
+/// Base class of every robotic object: error status, interactive commands, configuration from
+/// rp.cfg, shutdown, control panel, message handler and thread management (Figure 5).
+///
+/// An object registers with the ObjectManager in its constructor and leaves it in its
+/// destructor, from any thread. An object created with a name is configured from the rp.cfg
+/// section of that name (each constructor level reads its own settings from configSection());
+/// an object created without a name gets a unique automatic name such as `puma560_3`.
+///
+/// Classes that can be named in rp.cfg have a constructor taking `const std::string& name`
+/// and are registered with RP_REGISTER_CLASS (see TypeDatabase.hpp). The settings a class
+/// accepts are declared in a static `declareSettings(SettingSchema&)` that first calls its
+/// base class's.
+class RoboticObject {
+ public:
+  /// Creates the object and registers it with the ObjectManager.
+  /// @param[in] name  object name; empty for an automatic name. If the global configuration has
+  ///                  a section of this name, the object is configured from it.
+  /// @throws std::invalid_argument if another live object has the same name
+  /// Real-time safe: no.
+  explicit RoboticObject(const std::string& name = "");
+  /// Leaves the ObjectManager.
+  virtual ~RoboticObject();
+  RoboticObject(const RoboticObject&) = delete;             ///< objects are not copyable
+  RoboticObject& operator=(const RoboticObject&) = delete;  ///< objects are not copyable
+
+  /// Declares the settings every object accepts (`class` and `qmotorConfig` are handled by the
+  /// parser and always allowed).
+  /// @param[out] schema  schema to add to
+  static void declareSettings(SettingSchema& schema);
+
+  /// Object name (the given one, or the automatic one).
+  /// Real-time safe: no.
+  std::string getName() const;
+  /// Whether the name was generated automatically.
+  bool hasAutomaticName() const noexcept;
+  /// Class name as registered in the type database (or the C++ name without namespaces).
+  /// Real-time safe: no.
+  virtual std::string getClassName() const;
+  /// The rp.cfg section of this object, or nullptr if there is none.
+  const ConfigSection* configSection() const noexcept;
+
+  /// @name Error handling
+  /// @{
+  /// Sets the error status; a code of 0 clears it. The message is truncated to 255 bytes.
+  /// @param[in] code     error code, 0 for none
+  /// @param[in] message  what went wrong (NUL-terminated)
+  /// Real-time safe: yes (copies into a fixed buffer; never blocks on another thread for more
+  /// than a bounded number of attempts).
+  void setError(int code, const char* message) noexcept;
+  /// Clears the error status. Real-time safe: yes.
+  void clearError() noexcept { setError(0, ""); }
+  /// The error code, 0 for none. Real-time safe: yes.
+  int getErrorCode() const noexcept;
+  /// The error status with its message. Real-time safe: no.
+  ErrorStatus getErrorStatus() const;
+  /// @}
+
+  /// @name Interactive commands
+  /// @{
+  /// Registers a command invocable by name from a program or the GUI.
+  /// @param[in] name         command name, e.g. `Open Gripper`
+  /// @param[in] action       what it does (runs in the caller's thread)
+  /// @param[in] description  one line for the GUI
+  /// @throws std::invalid_argument if a command of that name exists
+  /// Real-time safe: no.
+  void addCommand(const std::string& name, std::function<void()> action, const std::string& description = "");
+  /// The registered commands in registration order. Real-time safe: no.
+  std::vector<CommandInfo> getCommands() const;
+  /// Runs the command `name`.
+  /// @param[in] name  command name
+  /// @throws std::invalid_argument if there is no such command (the message lists the known ones)
+  /// Real-time safe: no.
+  void executeCommand(const std::string& name);
+  /// @}
+
+  /// @name Shutdown
+  /// @{
+  /// Starts shutting the object down (bring it to rest, switch off power); must not block long.
+  /// The default marks the shutdown complete at once. Real-time safe: no.
+  virtual void startShutdown();
+  /// Whether the shutdown started by startShutdown() is complete. Real-time safe: yes.
+  virtual bool isShutdownComplete() const;
+  /// Whether startShutdown() has been called. Real-time safe: yes.
+  bool isShuttingDown() const noexcept;
+  /// Asks the ObjectManager to shut the whole system down (see ObjectManager::requestSystemShutdown).
+  /// @param[in] reason  a string that lives as long as the program (e.g. a literal)
+  /// Real-time safe: yes.
+  void requestSystemShutdown(const char* reason) noexcept;
+  /// @}
+
+  /// @name GUI
+  /// @{
+  /// The control panel description; the default has the object's name, class and error status.
+  /// Real-time safe: no.
+  virtual ControlPanel getControlPanel() const;
+  /// Copies the latest state published by the object; false if it publishes none (default).
+  /// @param[out] snapshot  receives the state
+  /// Real-time safe: no (may wait for other readers).
+  virtual bool getStateSnapshot(StateSnapshot& snapshot) const;
+  /// Handles a custom message; the default understands none.
+  /// @param[in]  type     message type
+  /// @param[in]  payload  message body (text, for example JSON)
+  /// @param[out] reply    the answer
+  /// @return true if the message was understood
+  /// Real-time safe: no.
+  virtual bool handleMessage(const std::string& type, const std::string& payload, std::string& reply);
+  /// @}
+
+  /// @name Thread management
+  /// @{
+  /// The control program that runs this object's control loop, or nullptr (default). Classes
+  /// derived from ControlProgram return `this`.
+  virtual ControlProgram* getControlProgram() { return nullptr; }
+  /// Whether the object needs a control loop.
+  bool needsControlLoop() { return getControlProgram() != nullptr; }
+  /// Starts the object's control loop in its own thread (the most-derived constructor calls this
+  /// last, so the loop never sees a half-constructed object). Does nothing without a loop.
+  /// Real-time safe: no.
+  void startControlLoop();
+  /// Stops the control loop and waits for its thread (derived destructors call this first).
+  /// Real-time safe: no.
+  void stopControlLoop();
+  /// @}
+
+  /// A plain description of the object for the object list. Real-time safe: no.
+  ObjectInfo getInfo();
+
+ protected:
+  /// Marks the shutdown complete (for classes overriding startShutdown()). Real-time safe: yes.
+  void setShutdownComplete() noexcept;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rp

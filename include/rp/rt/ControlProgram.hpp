@@ -1,0 +1,266 @@
+#pragma once
+/// @file
+/// ControlProgram: a periodic real-time loop with statistics, log variables and tunable
+/// parameters (paper section 3.8: QMotor's role).
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rp/math/Matrix.hpp"
+
+namespace rp {
+
+class Clock;
+class LogWriter;
+class ParameterFile;
+
+/// Summary of a set of durations, in microseconds.
+struct LatencyStatistics {
+  std::uint64_t count = 0;  ///< number of samples
+  double min = 0;           ///< smallest [µs]
+  double mean = 0;          ///< mean [µs]
+  double p50 = 0;           ///< median [µs] (1 µs histogram bins up to 10 ms)
+  double p99 = 0;           ///< 99th percentile [µs] (same bins)
+  double max = 0;           ///< largest [µs]
+};
+
+/// Statistics of a control program since start().
+struct ControlStatistics {
+  std::uint64_t cycles = 0;      ///< cycles run
+  std::uint64_t overruns = 0;    ///< deadlines missed (a cycle ended after the next deadline)
+  LatencyStatistics wakeupLatency;    ///< how late the thread woke after each deadline (real clock)
+  LatencyStatistics computationTime;  ///< time spent in control() and the bookkeeping around it
+  std::uint64_t logSamples = 0;       ///< log samples taken
+  std::uint64_t lostLogSamples = 0;   ///< log samples dropped because the ring buffer was full
+  bool realTimeScheduling = false;    ///< the thread runs with SCHED_FIFO
+  bool simulatedClock = false;        ///< the program runs on a simulated clock
+};
+
+/// A registered log variable (name and size fixed at configure time).
+struct LogVariableInfo {
+  std::string name;  ///< name, e.g. `q`; CSV columns are `program.name` or `program.name[i]`
+  std::size_t size = 1;  ///< number of values
+  bool vector = false;   ///< registered as a vector (columns get `[i]`)
+  std::string unit;      ///< unit, e.g. `rad`
+};
+
+/// A registered tunable parameter.
+struct ParameterInfo {
+  std::string name;         ///< name, e.g. `kp`
+  std::size_t size = 1;     ///< number of values
+  double min = 0;           ///< smallest allowed value
+  double max = 0;           ///< largest allowed value
+  std::string unit;         ///< unit
+  std::string description;  ///< one line for the tuning window
+};
+
+/// A periodic control loop in its own thread (QMotor's ControlProgram).
+///
+/// Derive from it and implement control(); register log variables and parameters in the
+/// constructor (before start()). start() spawns the thread, which runs at the set rate on its
+/// clock: on the real clock with absolute deadlines (`clock_nanosleep`, TIMER_ABSTIME), with
+/// `mlockall` and SCHED_FIFO at the set priority when the process may (otherwise one warning
+/// and normal scheduling); on a SimulatedClock in lockstep with the other programs on it.
+///
+/// Each cycle: wait for the deadline; apply parameter changes requested since the last cycle;
+/// call control(); sample the log variables every getLogEvery()-th cycle into a preallocated
+/// ring buffer read by a LogWriter's non-real-time thread. Nothing in the cycle allocates, locks
+/// or does I/O (tests/realtime/rt_alloc_test.cpp proves it).
+///
+/// A derived class whose control() uses its own members must call stop() in its destructor.
+class ControlProgram {
+ public:
+  /// Creates a stopped program.
+  /// @param[in] programName  name used for log columns (`name.variable`) and messages
+  explicit ControlProgram(const std::string& programName = "control");
+  /// Stops the thread if it still runs.
+  virtual ~ControlProgram();
+  ControlProgram(const ControlProgram&) = delete;             ///< not copyable
+  ControlProgram& operator=(const ControlProgram&) = delete;  ///< not copyable
+
+  /// Sets the name used for log columns.
+  /// @param[in] name  program name (no `,` or `.`)
+  void setProgramName(const std::string& name);
+  /// The program name.
+  const std::string& getProgramName() const;
+
+  /// @name Timing (set before start())
+  /// @{
+  /// Sets the loop rate (default 1000 Hz).
+  /// @param[in] hz  rate [Hz], > 0
+  /// @throws std::invalid_argument if not positive or if running
+  void setRate(double hz);
+  /// The loop rate [Hz].
+  double getRate() const;
+  /// The loop period [s].
+  double getPeriod() const;
+  /// Sets the SCHED_FIFO priority (default 27, as in the paper).
+  /// @param[in] priority  1..99
+  void setPriority(int priority);
+  /// The SCHED_FIFO priority.
+  int getPriority() const;
+  /// Runs the program on `clock` (default: RoboticPlatform::getDefaultClock()).
+  /// @param[in] clock  a clock that outlives the program's run
+  void setClock(Clock& clock);
+  /// The clock the program runs on.
+  Clock& getClock() const;
+  /// Stops the loop by itself after `cycles` cycles (0: never, the default).
+  /// @param[in] cycles  number of cycles
+  void setCycleLimit(std::uint64_t cycles);
+  /// @}
+
+  /// @name Running
+  /// @{
+  /// Starts the loop thread (calls enterControl() in it, then control() every cycle).
+  /// @throws std::logic_error if already running
+  /// Real-time safe: no.
+  void start();
+  /// Asks the loop to end after the current cycle and waits for the thread (from the loop's own
+  /// thread it only asks). Real-time safe: no.
+  void stop();
+  /// Asks the loop to end after the current cycle without waiting. Real-time safe: yes.
+  void requestStop() noexcept;
+  /// Waits until the loop has ended (cycle limit, requestStop() or stop()).
+  /// Real-time safe: no.
+  void waitUntilStopped();
+  /// Whether the loop thread runs.
+  bool isRunning() const noexcept;
+  /// Time of the current cycle on the program's clock [s]. Real-time safe: yes.
+  double getTime() const noexcept;
+  /// Number of cycles completed. Real-time safe: yes.
+  std::uint64_t getCycleCount() const noexcept;
+  /// Statistics since start(). Real-time safe: no.
+  ControlStatistics getStatistics() const;
+  /// @}
+
+  /// @name Log variables (register before start())
+  /// @{
+  /// Registers a scalar log variable sampled from `variable`.
+  /// @param[in] name      variable name
+  /// @param[in] variable  storage read every sampled cycle (must outlive the program's run)
+  /// @param[in] unit      unit
+  /// @throws std::invalid_argument for a duplicate or bad name; std::logic_error if running
+  void registerLogVariable(const std::string& name, const double& variable, const std::string& unit = "");
+  /// Registers a vector log variable of `size` doubles at `data`.
+  /// @param[in] name  variable name
+  /// @param[in] data  first value (must outlive the program's run)
+  /// @param[in] size  number of values
+  /// @param[in] unit  unit
+  void registerLogVariable(const std::string& name, const double* data, std::size_t size, const std::string& unit = "");
+  /// Registers a fixed-size vector (e.g. `Vector<6>` joint positions).
+  /// @param[in] name  variable name
+  /// @param[in] v     the vector (must outlive the program's run)
+  /// @param[in] unit  unit
+  template <int n>
+  void registerLogVariable(const std::string& name, const Vector<n>& v, const std::string& unit = "") {
+    registerLogVariable(name, v.data(), static_cast<std::size_t>(n), unit);
+  }
+  /// The registered log variables.
+  std::vector<LogVariableInfo> getLogVariables() const;
+  /// Samples every n-th cycle (default 1).
+  /// @param[in] n  decimation, >= 1
+  void setLogEvery(unsigned n);
+  /// The log decimation.
+  unsigned getLogEvery() const;
+  /// Sets the ring-buffer capacity in samples (default 4096).
+  /// @param[in] samples  capacity, >= 2
+  void setLogBufferSize(std::size_t samples);
+  /// Sends this program's samples to `writer` (default: the platform's `-log` writer, if any).
+  /// @param[in] writer  log writer that outlives the run, or nullptr for none
+  void setLogWriter(LogWriter* writer);
+  /// @}
+
+  /// @name Tunable parameters (register before start(); set from any thread)
+  /// @{
+  /// Registers a scalar parameter stored in `target`, applied at the start of a cycle.
+  /// @param[in] name         parameter name
+  /// @param[in,out] target   storage the loop reads (written only by the loop's thread while running)
+  /// @param[in] min          smallest allowed value
+  /// @param[in] max          largest allowed value
+  /// @param[in] unit         unit
+  /// @param[in] description  one line for the tuning window
+  /// @throws std::invalid_argument for a duplicate name, min > max, or a current value out of range
+  void registerParameter(const std::string& name, double& target, double min, double max, const std::string& unit = "",
+                         const std::string& description = "");
+  /// Registers a vector parameter of `size` values at `target`.
+  /// @param[in] name         parameter name
+  /// @param[in,out] target   first value
+  /// @param[in] size         number of values
+  /// @param[in] min          smallest allowed value (each element)
+  /// @param[in] max          largest allowed value (each element)
+  /// @param[in] unit         unit
+  /// @param[in] description  one line for the tuning window
+  void registerParameter(const std::string& name, double* target, std::size_t size, double min, double max,
+                         const std::string& unit = "", const std::string& description = "");
+  /// Registers a fixed-size vector parameter (e.g. `Vector<6>` gains).
+  /// @param[in] name         parameter name
+  /// @param[in,out] target   the vector
+  /// @param[in] min          smallest allowed value
+  /// @param[in] max          largest allowed value
+  /// @param[in] unit         unit
+  /// @param[in] description  one line for the tuning window
+  template <int n>
+  void registerParameter(const std::string& name, Vector<n>& target, double min, double max,
+                         const std::string& unit = "", const std::string& description = "") {
+    registerParameter(name, target.data(), static_cast<std::size_t>(n), min, max, unit, description);
+  }
+  /// Requests a new value for every element of parameter `name`; the loop applies it at the
+  /// start of its next cycle (at once when not running).
+  /// @param[in] name   parameter name
+  /// @param[in] value  new value
+  /// @throws std::out_of_range if outside [min, max]; std::invalid_argument for an unknown name
+  /// Real-time safe: no.
+  void setParameter(const std::string& name, double value);
+  /// Requests a new value for element `index` of parameter `name`.
+  /// @param[in] name   parameter name
+  /// @param[in] index  element, from 0
+  /// @param[in] value  new value
+  /// @throws std::out_of_range if outside [min, max] or index too large
+  void setParameter(const std::string& name, std::size_t index, double value);
+  /// Requests new values for all elements of parameter `name` (applied together).
+  /// @param[in] name    parameter name
+  /// @param[in] values  one value per element
+  /// @throws std::out_of_range / std::invalid_argument as above, or for a wrong count
+  void setParameter(const std::string& name, const std::vector<double>& values);
+  /// The latest requested (or applied) values of parameter `name`.
+  /// @param[in] name  parameter name
+  std::vector<double> getParameter(const std::string& name) const;
+  /// The registered parameters.
+  std::vector<ParameterInfo> getParameters() const;
+  /// @}
+
+  /// @name Control-program file (`qmotorConfig`)
+  /// @{
+  /// Applies a control-program file: `name v1 v2 ...` sets parameter `name`; `rate HZ`,
+  /// `priority P`, `logEvery N`, `logBufferSize N` and `log var1 var2 ...` (variables to log;
+  /// default all) set the program's settings.
+  /// @param[in] file  parsed file
+  /// @throws ConfigError naming the file and line for an unknown name, a wrong count or a value out of range
+  void applyQMotorConfig(const ParameterFile& file);
+  /// Writes the current parameters and log settings in the same format.
+  /// @param[in] fileName  path to write
+  /// @throws std::runtime_error if it cannot be written
+  void saveQMotorConfig(const std::string& fileName) const;
+  /// @}
+
+  /// Stops every running control program (system shutdown, exit). Real-time safe: no.
+  static void stopAll();
+
+ protected:
+  /// Called in the loop thread before the first cycle (not time-critical).
+  virtual void enterControl() {}
+  /// One control cycle. Must not allocate, lock or do I/O. Real-time safe: must be.
+  virtual void control() = 0;
+  /// Called in the loop thread after the last cycle.
+  virtual void exitControl() {}
+
+ private:
+  struct Impl;
+  friend struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rp
