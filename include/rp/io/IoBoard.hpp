@@ -1,0 +1,110 @@
+#pragma once
+/// @file
+/// The generic interface of an I/O board: digital and analog inputs and outputs, encoder counters.
+
+#include <cstdint>
+
+#include "rp/io/DeviceError.hpp"
+#include "rp/io/IoStatus.hpp"
+
+namespace rp {
+
+/// Generic interface of an I/O board (the paper's hardware interfacing, section 1, and the
+/// boards behind QMotor's hardware servers, section 3.8): digital inputs and outputs, analog
+/// inputs and outputs in volts, and encoder counters.
+///
+/// Lines, channels and encoders are numbered from 0. Every operation returns an `IoStatus`;
+/// on failure `lastError()` says what went wrong. Whether an operation is real-time safe depends
+/// on the implementation: `SimulatedIoBoard` and `HwServerIoBoard` are, `ModbusIoBoard` is not
+/// (it does a network round trip), which is why a servo loop reaches a network board through
+/// a hardware server (`rp-hwserver`).
+///
+/// Example: `bool in; if (board.readDigitalInput(0, in) != IoStatus::kOk) puts(board.lastError());`
+class IoBoard {
+ public:
+  virtual ~IoBoard() = default;
+
+  /// Number of digital input lines.
+  /// Real-time safe: yes.
+  virtual int numDigitalInputs() const noexcept = 0;
+  /// Number of digital output lines.
+  /// Real-time safe: yes.
+  virtual int numDigitalOutputs() const noexcept = 0;
+  /// Number of analog input channels.
+  /// Real-time safe: yes.
+  virtual int numAnalogInputs() const noexcept = 0;
+  /// Number of analog output channels.
+  /// Real-time safe: yes.
+  virtual int numAnalogOutputs() const noexcept = 0;
+  /// Number of encoder counters.
+  /// Real-time safe: yes.
+  virtual int numEncoders() const noexcept = 0;
+
+  /// Reads a digital input line.
+  /// @param[in] line  input line, 0 .. numDigitalInputs()-1
+  /// @param[out] value  the line's state (unchanged on failure)
+  /// @return `kOk`, `kInvalidLine`, or a communication error
+  /// Real-time safe: depends on the implementation (see the class comment).
+  virtual IoStatus readDigitalInput(int line, bool& value) noexcept = 0;
+
+  /// Sets a digital output line.
+  /// @param[in] line  output line, 0 .. numDigitalOutputs()-1
+  /// @param[in] value  true = on
+  /// @return `kOk`, `kInvalidLine`, or a communication error
+  /// Real-time safe: depends on the implementation.
+  virtual IoStatus writeDigitalOutput(int line, bool value) noexcept = 0;
+
+  /// Reads back the state of a digital output line.
+  /// @param[in] line  output line, 0 .. numDigitalOutputs()-1
+  /// @param[out] value  the line's state (unchanged on failure)
+  /// @return `kOk`, `kInvalidLine`, or a communication error
+  /// Real-time safe: depends on the implementation.
+  virtual IoStatus readDigitalOutput(int line, bool& value) noexcept = 0;
+
+  /// Reads an analog input channel.
+  /// @param[in] channel  0 .. numAnalogInputs()-1
+  /// @param[out] volts  the input voltage [V] (unchanged on failure)
+  /// @return `kOk`, `kInvalidLine`, or a communication error
+  /// Real-time safe: depends on the implementation.
+  virtual IoStatus readAnalogInput(int channel, double& volts) noexcept = 0;
+
+  /// Sets an analog output channel.
+  /// @param[in] channel  0 .. numAnalogOutputs()-1
+  /// @param[in] volts  the output voltage [V]; the implementation clamps it to its range
+  /// @return `kOk`, `kInvalidLine`, or a communication error
+  /// Real-time safe: depends on the implementation.
+  virtual IoStatus writeAnalogOutput(int channel, double volts) noexcept = 0;
+
+  /// Reads an encoder counter.
+  /// @param[in] encoder  0 .. numEncoders()-1
+  /// @param[out] counts  the counter value [counts] (unchanged on failure)
+  /// @return `kOk`, `kInvalidLine`, or a communication error
+  /// Real-time safe: depends on the implementation.
+  virtual IoStatus readEncoder(int encoder, std::int64_t& counts) noexcept = 0;
+
+  /// Status of the last failed operation (`kOk` if none failed yet).
+  /// Real-time safe: yes.
+  IoStatus lastStatus() const noexcept { return error_.status(); }
+
+  /// Message of the last failed operation, for example
+  /// `"ModbusIoBoard 127.0.0.1:1502: connection refused"` (empty if none failed yet).
+  /// Real-time safe: yes.
+  const char* lastError() const noexcept { return error_.message(); }
+
+ protected:
+  /// Records a failed operation: implementations call `return error_.set(status, "...", ...)`.
+  DeviceError error_;
+
+  /// Checks an index against a count and records `kInvalidLine` naming `what` if it is outside.
+  /// @param[in] index  the line, channel or encoder number
+  /// @param[in] count  how many the board has
+  /// @param[in] what  what is indexed, e.g. "digital output"
+  /// @return `kOk` or `kInvalidLine`
+  /// Real-time safe: yes.
+  IoStatus checkIndex(int index, int count, const char* what) noexcept {
+    if (index >= 0 && index < count) return IoStatus::kOk;
+    return error_.set(IoStatus::kInvalidLine, "%s %d out of range (board has %d)", what, index, count);
+  }
+};
+
+}  // namespace rp
