@@ -1,0 +1,153 @@
+// rp-hwserver: a QMotor-style hardware server. Does one I/O board's I/O at a fixed rate and serves
+// its lines to any number of client programs (HwServerIoBoard) through POSIX shared memory.
+//
+//   rp-hwserver -name NAME [-rate HZ] [-duration S] -board simulated [-loopback]
+//               [-digitalInputs N] [-digitalOutputs N] [-analogInputs N] [-analogOutputs N] [-encoders N]
+//   rp-hwserver -name NAME [-rate HZ] [-duration S] -board modbus [-address A] -port P [-unit ID]
+//               [-timeout MS] [-coils LIST] [-discreteInputs LIST] [-inputRegisters LIST]
+//               [-holdingRegisters LIST] [-encoderRegisters LIST] [-voltsPerCount V]
+// LIST is comma-separated register or coil addresses, one per line (e.g. -coils 0,1,2,3).
+// Prints "rp-hwserver: serving NAME ..." once clients can attach; stops on SIGINT/SIGTERM or after
+// -duration seconds, setting every output to zero. Exit status 2 for bad arguments, 1 for errors.
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rp/io/HwServer.hpp"
+#include "rp/io/IoException.hpp"
+#include "rp/io/ModbusIoBoard.hpp"
+#include "rp/io/SimulatedIoBoard.hpp"
+
+namespace {
+
+volatile std::sig_atomic_t gStop = 0;
+void onSignal(int) { gStop = 1; }
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+int toInt(const std::string& option, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const int v = std::stoi(text, &used);
+    if (used == text.size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw UsageError(option + ": '" + text + "' is not an integer");
+}
+
+double toDouble(const std::string& option, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used == text.size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw UsageError(option + ": '" + text + "' is not a number");
+}
+
+std::vector<int> toList(const std::string& option, const std::string& text) {
+  std::vector<int> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) out.push_back(toInt(option, item));
+  return out;
+}
+
+constexpr const char* kUsage =
+    "usage: rp-hwserver -name NAME [-rate HZ] [-duration S] -board simulated|modbus [board options]\n"
+    "  simulated: [-loopback] [-digitalInputs N] [-digitalOutputs N] [-analogInputs N] [-analogOutputs N] [-encoders N]\n"
+    "  modbus:    [-address A] -port P [-unit ID] [-timeout MS] [-coils LIST] [-discreteInputs LIST]\n"
+    "             [-inputRegisters LIST] [-holdingRegisters LIST] [-encoderRegisters LIST] [-voltsPerCount V]\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string name, board;
+  double rate = 1000.0, duration = 0.0;
+  rp::SimulatedIoBoard::Config sim;
+  rp::ModbusIoBoard::Config modbus;
+  modbus.port = 0;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string opt = argv[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw UsageError(opt + " needs a value");
+        return argv[++i];
+      };
+      if (opt == "-name") name = value();
+      else if (opt == "-rate") rate = toDouble(opt, value());
+      else if (opt == "-duration") duration = toDouble(opt, value());
+      else if (opt == "-board") board = value();
+      else if (opt == "-loopback") sim.loopback = true;
+      else if (opt == "-digitalInputs") sim.digitalInputs = toInt(opt, value());
+      else if (opt == "-digitalOutputs") sim.digitalOutputs = toInt(opt, value());
+      else if (opt == "-analogInputs") sim.analogInputs = toInt(opt, value());
+      else if (opt == "-analogOutputs") sim.analogOutputs = toInt(opt, value());
+      else if (opt == "-encoders") sim.encoders = toInt(opt, value());
+      else if (opt == "-address") modbus.address = value();
+      else if (opt == "-port") modbus.port = toInt(opt, value());
+      else if (opt == "-unit") modbus.unitId = toInt(opt, value());
+      else if (opt == "-timeout") modbus.responseTimeoutMs = toInt(opt, value());
+      else if (opt == "-coils") modbus.digitalOutputCoils = toList(opt, value());
+      else if (opt == "-discreteInputs") modbus.digitalInputs = toList(opt, value());
+      else if (opt == "-inputRegisters") modbus.analogInputRegisters = toList(opt, value());
+      else if (opt == "-holdingRegisters") modbus.analogOutputRegisters = toList(opt, value());
+      else if (opt == "-encoderRegisters") modbus.encoderRegisters = toList(opt, value());
+      else if (opt == "-voltsPerCount") modbus.voltsPerCount = toDouble(opt, value());
+      else if (opt == "-h" || opt == "-help" || opt == "--help") {
+        std::cout << kUsage;
+        return 0;
+      } else {
+        throw UsageError("unknown option '" + opt + "'");
+      }
+    }
+    if (name.empty()) throw UsageError("-name is required");
+    if (board != "simulated" && board != "modbus") throw UsageError("-board must be simulated or modbus");
+    if (duration < 0) throw UsageError("-duration must not be negative");
+  } catch (const UsageError& e) {
+    std::cerr << "rp-hwserver: " << e.what() << "\n" << kUsage;
+    return 2;
+  }
+
+  try {
+    std::unique_ptr<rp::IoBoard> io;
+    if (board == "simulated") io = std::make_unique<rp::SimulatedIoBoard>(sim);
+    else io = std::make_unique<rp::ModbusIoBoard>(modbus);
+    rp::HwServer server(*io, name, rate);
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    server.start();
+    std::cout << "rp-hwserver: serving " << name << " (" << board << " board, " << io->numDigitalInputs()
+              << " DI, " << io->numDigitalOutputs() << " DO, " << io->numAnalogInputs() << " AI, "
+              << io->numAnalogOutputs() << " AO, " << io->numEncoders() << " encoders) at " << rate << " Hz"
+              << std::endl;
+    rp::IoStatus lastStatus = rp::IoStatus::kOk;
+    const auto start = std::chrono::steady_clock::now();
+    while (!gStop) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      const rp::IoStatus s = server.boardStatus();
+      if (s != lastStatus) {  // report board failures and recoveries once each
+        if (s != rp::IoStatus::kOk) std::cerr << "rp-hwserver: board error: " << rp::toString(s) << std::endl;
+        else std::cerr << "rp-hwserver: board working again" << std::endl;
+        lastStatus = s;
+      }
+      if (duration > 0 && std::chrono::steady_clock::now() - start > std::chrono::duration<double>(duration)) break;
+    }
+    server.stop();
+    std::cout << "rp-hwserver: stopped after " << server.cycles() << " cycles, " << server.overruns() << " overruns"
+              << std::endl;
+  } catch (const rp::IoException& e) {
+    std::cerr << "rp-hwserver: " << e.what() << std::endl;
+    return 1;
+  }
+  return 0;
+}
