@@ -15,6 +15,8 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+
+#include "Arguments.hpp"
 #include <vector>
 
 #include "BarrettHandEmulator.hpp"
@@ -23,28 +25,12 @@
 
 namespace {
 
+using rp::emulator::toDouble;
+using rp::emulator::toInt;
+using rp::emulator::UsageError;
+
 volatile std::sig_atomic_t gStop = 0;
 void onSignal(int) { gStop = 1; }
-
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-double toDouble(const std::string& option, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(text, &used);
-    if (used == text.size()) return v;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(option + ": '" + text + "' is not a number");
-}
-
-int toInt(const std::string& option, const std::string& text) {
-  const double v = toDouble(option, text);
-  if (v != static_cast<int>(v)) throw UsageError(option + ": '" + text + "' is not an integer");
-  return static_cast<int>(v);
-}
 
 constexpr const char* kUsage =
     "usage: rp-emulate modbus [-port P] [-duration S]\n"

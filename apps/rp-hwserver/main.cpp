@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "Arguments.hpp"
 #include "rp/io/HwServer.hpp"
 #include "rp/io/IoException.hpp"
 #include "rp/io/ModbusIoBoard.hpp"
@@ -27,40 +28,13 @@
 
 namespace {
 
+using rp::emulator::toDouble;
+using rp::emulator::toInt;
+using rp::emulator::toIntList;
+using rp::emulator::UsageError;
+
 volatile std::sig_atomic_t gStop = 0;
 void onSignal(int) { gStop = 1; }
-
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-int toInt(const std::string& option, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const int v = std::stoi(text, &used);
-    if (used == text.size()) return v;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(option + ": '" + text + "' is not an integer");
-}
-
-double toDouble(const std::string& option, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(text, &used);
-    if (used == text.size()) return v;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(option + ": '" + text + "' is not a number");
-}
-
-std::vector<int> toList(const std::string& option, const std::string& text) {
-  std::vector<int> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) out.push_back(toInt(option, item));
-  return out;
-}
 
 constexpr const char* kUsage =
     "usage: rp-hwserver -name NAME [-rate HZ] [-duration S] -board simulated|modbus [board options]\n"
@@ -97,11 +71,11 @@ int main(int argc, char** argv) {
       else if (opt == "-port") modbus.port = toInt(opt, value());
       else if (opt == "-unit") modbus.unitId = toInt(opt, value());
       else if (opt == "-timeout") modbus.responseTimeoutMs = toInt(opt, value());
-      else if (opt == "-coils") modbus.digitalOutputCoils = toList(opt, value());
-      else if (opt == "-discreteInputs") modbus.digitalInputs = toList(opt, value());
-      else if (opt == "-inputRegisters") modbus.analogInputRegisters = toList(opt, value());
-      else if (opt == "-holdingRegisters") modbus.analogOutputRegisters = toList(opt, value());
-      else if (opt == "-encoderRegisters") modbus.encoderRegisters = toList(opt, value());
+      else if (opt == "-coils") modbus.digitalOutputCoils = toIntList(opt, value());
+      else if (opt == "-discreteInputs") modbus.digitalInputs = toIntList(opt, value());
+      else if (opt == "-inputRegisters") modbus.analogInputRegisters = toIntList(opt, value());
+      else if (opt == "-holdingRegisters") modbus.analogOutputRegisters = toIntList(opt, value());
+      else if (opt == "-encoderRegisters") modbus.encoderRegisters = toIntList(opt, value());
       else if (opt == "-voltsPerCount") modbus.voltsPerCount = toDouble(opt, value());
       else if (opt == "-h" || opt == "-help" || opt == "--help") {
         std::cout << kUsage;

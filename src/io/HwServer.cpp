@@ -19,12 +19,6 @@ namespace rp {
 
 namespace {
 
-std::int64_t monotonicNs() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
 bool validName(const std::string& name) {
   if (name.empty() || name.size() > 64) return false;
   return std::all_of(name.begin(), name.end(), [](char c) {
@@ -165,20 +159,20 @@ void HwServer::cycle(bool writeAll) {
     shm_->messageSeq.fetch_add(1, std::memory_order_release);
   }
   shm_->boardStatus.store(static_cast<std::int32_t>(status));
-  shm_->heartbeatNs.store(monotonicNs());
+  shm_->heartbeatNs.store(internal::monotonicNs());
   shm_->cycle.fetch_add(1);
 }
 
 void HwServer::run() {
   const auto periodNs = static_cast<std::int64_t>(std::llround(1e9 / rateHz_));
-  std::int64_t next = monotonicNs();
+  std::int64_t next = internal::monotonicNs();
   while (!stopRequested_.load()) {
     next += periodNs;
     timespec ts{static_cast<time_t>(next / 1'000'000'000), static_cast<long>(next % 1'000'000'000)};
     while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
     }
     if (stopRequested_.load()) break;
-    const std::int64_t now = monotonicNs();
+    const std::int64_t now = internal::monotonicNs();
     if (now > next + periodNs) {  // a whole period late: count it and do not try to catch up
       shm_->overruns.fetch_add(1);
       next = now;

@@ -14,14 +14,6 @@
 
 namespace rp {
 
-namespace {
-std::int64_t monotonicNs() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-}  // namespace
-
 HwServerIoBoard::HwServerIoBoard(const std::string& name, int staleTimeoutMs)
     : name_(name), staleTimeoutMs_(staleTimeoutMs) {
   if (staleTimeoutMs <= 0)
@@ -66,7 +58,7 @@ std::uint64_t HwServerIoBoard::serverCycles() const noexcept { return shm_->cycl
 IoStatus HwServerIoBoard::checkServer() noexcept {
   if (shm_->state.load() != static_cast<std::int32_t>(internal::HwServerState::kRunning))
     return error_.set(IoStatus::kNotConnected, "hardware server '%s' has stopped", name_.c_str());
-  const std::int64_t ageMs = (monotonicNs() - shm_->heartbeatNs.load()) / 1'000'000;
+  const std::int64_t ageMs = (internal::monotonicNs() - shm_->heartbeatNs.load()) / 1'000'000;
   if (ageMs > staleTimeoutMs_)
     return error_.set(IoStatus::kNotConnected, "hardware server '%s' is not responding (last cycle %ld ms ago)",
                       name_.c_str(), static_cast<long>(ageMs));
@@ -93,11 +85,11 @@ IoStatus HwServerIoBoard::checked(int index, int count, const char* what) noexce
 
 IoStatus HwServerIoBoard::waitForCycle(int timeoutMs) noexcept {
   const std::uint64_t start = shm_->cycle.load();
-  const std::int64_t deadline = monotonicNs() + static_cast<std::int64_t>(timeoutMs) * 1'000'000;
+  const std::int64_t deadline = internal::monotonicNs() + static_cast<std::int64_t>(timeoutMs) * 1'000'000;
   // Two increments guarantee a whole cycle ran after the call started.
   while (shm_->cycle.load() < start + 2) {
     if (IoStatus s = checkServer(); s == IoStatus::kNotConnected) return s;
-    if (monotonicNs() > deadline)
+    if (internal::monotonicNs() > deadline)
       return error_.set(IoStatus::kTimeout, "hardware server '%s' did not cycle within %d ms", name_.c_str(),
                         timeoutMs);
     ::usleep(200);

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <string>
 
+#include <time.h>
+
 namespace rp::internal {
 
 constexpr std::uint64_t kHwServerMagic = 0x52504857'53525631ULL;  // "RPHWSRV1"
@@ -38,6 +40,13 @@ struct HwServerShm {
 
 static_assert(std::atomic<double>::is_always_lock_free && std::atomic<std::int64_t>::is_always_lock_free,
               "the shared-memory protocol needs lock-free atomics");
+
+// CLOCK_MONOTONIC in nanoseconds: the same clock in every process of the machine.
+inline std::int64_t monotonicNs() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
 
 inline std::string hwServerShmName(const std::string& name) { return "/rp-hwserver-" + name; }
 
