@@ -119,6 +119,7 @@ class RoboticObject {
 
   /// @name Error handling
   /// @{
+
   /// Sets the error status; a code of 0 clears it. The message is truncated to 255 bytes.
   /// @param[in] code     error code, 0 for none
   /// @param[in] message  what went wrong (NUL-terminated)
@@ -135,6 +136,7 @@ class RoboticObject {
 
   /// @name Interactive commands
   /// @{
+
   /// Registers a command invocable by name from a program or the GUI.
   /// @param[in] name         command name, e.g. `Open Gripper`
   /// @param[in] action       what it does (runs in the caller's thread)
@@ -153,6 +155,7 @@ class RoboticObject {
 
   /// @name Shutdown
   /// @{
+
   /// Starts shutting the object down (bring it to rest, switch off power); must not block long.
   /// The default marks the shutdown complete at once. Real-time safe: no.
   virtual void startShutdown();
@@ -168,6 +171,7 @@ class RoboticObject {
 
   /// @name GUI
   /// @{
+
   /// The control panel description; the default has the object's name, class and error status.
   /// Real-time safe: no.
   virtual ControlPanel getControlPanel() const;
@@ -186,6 +190,7 @@ class RoboticObject {
 
   /// @name Thread management
   /// @{
+
   /// The control program that runs this object's control loop, or nullptr (default). Classes
   /// derived from ControlProgram return `this`.
   virtual ControlProgram* getControlProgram() { return nullptr; }

@@ -59,6 +59,9 @@ class SimulatedClock : public Clock {
   std::uint64_t getTick() const noexcept;
   /// The step [s].
   double getStep() const noexcept { return step_; }
+  /// Time of tick `tick` [s] (tick / steps-per-second when that is a whole number).
+  /// @param[in] tick  a tick number
+  double tickTime(std::uint64_t tick) const noexcept;
   /// Stops time from advancing (programs wait at their next cycle).
   void pause();
   /// Lets time advance again.

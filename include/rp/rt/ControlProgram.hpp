@@ -89,6 +89,7 @@ class ControlProgram {
 
   /// @name Timing (set before start())
   /// @{
+
   /// Sets the loop rate (default 1000 Hz).
   /// @param[in] hz  rate [Hz], > 0
   /// @throws std::invalid_argument if not positive or if running
@@ -114,6 +115,7 @@ class ControlProgram {
 
   /// @name Running
   /// @{
+
   /// Starts the loop thread (calls enterControl() in it, then control() every cycle).
   /// @throws std::logic_error if already running
   /// Real-time safe: no.
@@ -138,6 +140,7 @@ class ControlProgram {
 
   /// @name Log variables (register before start())
   /// @{
+
   /// Registers a scalar log variable sampled from `variable`.
   /// @param[in] name      variable name
   /// @param[in] variable  storage read every sampled cycle (must outlive the program's run)
@@ -175,6 +178,7 @@ class ControlProgram {
 
   /// @name Tunable parameters (register before start(); set from any thread)
   /// @{
+
   /// Registers a scalar parameter stored in `target`, applied at the start of a cycle.
   /// @param[in] name         parameter name
   /// @param[in,out] target   storage the loop reads (written only by the loop's thread while running)
@@ -234,6 +238,7 @@ class ControlProgram {
 
   /// @name Control-program file (`qmotorConfig`)
   /// @{
+
   /// Applies a control-program file: `name v1 v2 ...` sets parameter `name`; `rate HZ`,
   /// `priority P`, `logEvery N`, `logBufferSize N` and `log var1 var2 ...` (variables to log;
   /// default all) set the program's settings.

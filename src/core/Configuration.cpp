@@ -1,0 +1,444 @@
+// rp.cfg and control-program (qmotorConfig) file parsing; every error names FILE:LINE.
+#include "rp/core/Configuration.hpp"
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "rp/core/TypeDatabase.hpp"
+
+namespace rp {
+
+namespace internal {
+
+std::string joinWords(const std::vector<std::string>& words, const char* separator) {
+  std::string out;
+  for (const auto& w : words) {
+    if (!out.empty()) out += separator;
+    out += w;
+  }
+  return out;
+}
+
+// Parses a whole token as a finite double ("+1", "-2.5e3"); false if it is not one.
+bool parseNumber(const std::string& token, double& value) {
+  const char* begin = token.data();
+  const char* end = token.data() + token.size();
+  if (begin != end && *begin == '+') ++begin;
+  if (begin == end) return false;
+  auto [ptr, ec] = std::from_chars(begin, end, value);
+  return ec == std::errc() && ptr == end;
+}
+
+std::string readTextFile(const std::string& fileName) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(fileName, ec)) throw ConfigError(fileName, 0, "cannot read the file: it is a directory");
+  std::ifstream in(fileName, std::ios::binary);
+  if (!in) throw ConfigError(fileName, 0, std::string("cannot read the file: ") + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ConfigError(fileName, 0, "cannot read the file: read error");
+  return text.str();
+}
+
+namespace {
+
+// One line split into words with comments removed; `line` counts from 1.
+struct Line {
+  int number;
+  std::string trimmed;
+  std::vector<std::string> words;
+};
+
+bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+std::vector<Line> splitLines(const std::string& text, const std::string& fileName) {
+  std::vector<Line> lines;
+  int number = 1;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string raw = text.substr(start, end - start);
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      const auto c = static_cast<unsigned char>(raw[i]);
+      if ((c < 0x20 && !isSpace(static_cast<char>(c))) || c == 0x7f) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "the file is not a text file (byte 0x%02x in column %zu)", c, i + 1);
+        throw ConfigError(fileName, number, buf);
+      }
+    }
+    // A comment starts at '#' at the start of the line or after white space.
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      if (raw[i] == '#' && (i == 0 || isSpace(raw[i - 1]))) {
+        raw.resize(i);
+        break;
+      }
+    }
+    Line line{number, {}, {}};
+    std::size_t b = 0, e = raw.size();
+    while (b < e && isSpace(raw[b])) ++b;
+    while (e > b && isSpace(raw[e - 1])) --e;
+    line.trimmed = raw.substr(b, e - b);
+    std::size_t i = 0;
+    while (i < line.trimmed.size()) {
+      while (i < line.trimmed.size() && isSpace(line.trimmed[i])) ++i;
+      std::size_t j = i;
+      while (j < line.trimmed.size() && !isSpace(line.trimmed[j])) ++j;
+      if (j > i) line.words.push_back(line.trimmed.substr(i, j - i));
+      i = j;
+    }
+    if (!line.words.empty()) lines.push_back(std::move(line));
+    if (end == text.size()) break;
+    start = end + 1;
+    ++number;
+  }
+  return lines;
+}
+
+bool isIdentifier(const std::string& s, bool allowDash) {
+  if (s.empty()) return false;
+  if (!(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  return std::all_of(s.begin(), s.end(), [&](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || (allowDash && c == '-');
+  });
+}
+
+std::string describeCount(const SettingSpec& spec) {
+  std::string n = spec.minValues == spec.maxValues
+                      ? std::to_string(spec.minValues)
+                      : std::to_string(spec.minValues) + " to " + std::to_string(spec.maxValues);
+  std::string what = n + (spec.maxValues == 1 ? " value" : " values");
+  std::string detail = spec.kind == SettingKind::Choice ? joinWords(spec.choices, ", ") : spec.description;
+  if (!spec.unit.empty()) detail += (detail.empty() ? "" : " ") + std::string("[") + spec.unit + "]";
+  if (!detail.empty()) what += " (" + detail + ")";
+  return what;
+}
+
+std::string resolvePath(const std::string& configFile, const std::string& path) {
+  std::filesystem::path p(path);
+  if (p.is_absolute()) return path;
+  std::filesystem::path dir = std::filesystem::path(configFile).parent_path();
+  return dir.empty() ? path : (dir / p).string();
+}
+
+}  // namespace
+
+// Checks one setting against its declaration; throws at the setting's line.
+void checkSetting(const SettingSpec& spec, const ConfigSetting& s, const std::string& file) {
+  const int n = static_cast<int>(s.values.size());
+  if (n < spec.minValues || n > spec.maxValues)
+    throw ConfigError(file, s.line,
+                      "setting '" + s.name + "' needs " + describeCount(spec) + ", got " + std::to_string(n));
+  for (const auto& v : s.values) {
+    switch (spec.kind) {
+      case SettingKind::Number: {
+        double d;
+        if (!parseNumber(v, d)) {
+          std::string reason = "is not a number";
+          if (std::from_chars(v.data(), v.data() + v.size(), d).ec == std::errc() && !std::isfinite(d))
+            reason = "is not a finite number";
+          throw ConfigError(file, s.line, "setting '" + s.name + "': '" + v + "' " + reason);
+        }
+        if (!std::isfinite(d)) throw ConfigError(file, s.line, "setting '" + s.name + "': '" + v + "' is not a finite number");
+        break;
+      }
+      case SettingKind::Integer: {
+        long long x;
+        const char* b = v.data();
+        if (!v.empty() && v[0] == '+') ++b;
+        auto [ptr, ec] = std::from_chars(b, v.data() + v.size(), x);
+        if (ec != std::errc() || ptr != v.data() + v.size() || b == v.data() + v.size())
+          throw ConfigError(file, s.line, "setting '" + s.name + "': '" + v + "' is not an integer");
+        break;
+      }
+      case SettingKind::Choice:
+        if (std::find(spec.choices.begin(), spec.choices.end(), v) == spec.choices.end())
+          throw ConfigError(file, s.line,
+                            "setting '" + s.name + "': '" + v + "' is not one of " + joinWords(spec.choices, ", "));
+        break;
+      case SettingKind::Word:
+        break;
+    }
+  }
+}
+
+}  // namespace internal
+
+// ---- ConfigError -----------------------------------------------------------------------------
+
+ConfigError::ConfigError(const std::string& file, int line, const std::string& message)
+    : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + message),
+      file_(file),
+      line_(line),
+      message_(message) {}
+
+// ---- SettingSchema ---------------------------------------------------------------------------
+
+void SettingSchema::add(const SettingSpec& spec) {
+  for (auto& s : specs_)
+    if (s.name == spec.name) {
+      s = spec;
+      return;
+    }
+  specs_.push_back(spec);
+}
+
+void SettingSchema::addNumbers(const std::string& name, int count, const std::string& unit,
+                               const std::string& description) {
+  add(SettingSpec{name, SettingKind::Number, count, count, {}, unit, description});
+}
+
+void SettingSchema::addInteger(const std::string& name, const std::string& description) {
+  add(SettingSpec{name, SettingKind::Integer, 1, 1, {}, "", description});
+}
+
+void SettingSchema::addWord(const std::string& name, const std::string& description) {
+  add(SettingSpec{name, SettingKind::Word, 1, 1, {}, "", description});
+}
+
+void SettingSchema::addChoice(const std::string& name, const std::vector<std::string>& choices,
+                              const std::string& description) {
+  add(SettingSpec{name, SettingKind::Choice, 1, 1, choices, "", description});
+}
+
+const SettingSpec* SettingSchema::find(const std::string& name) const {
+  for (const auto& s : specs_)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+std::string SettingSchema::knownNames() const {
+  std::vector<std::string> names{"qmotorConfig"};
+  for (const auto& s : specs_) names.push_back(s.name);
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  return internal::joinWords(names, ", ");
+}
+
+// ---- ParameterFile ---------------------------------------------------------------------------
+
+ParameterFile ParameterFile::read(const std::string& fileName) {
+  return parse(internal::readTextFile(fileName), fileName);
+}
+
+ParameterFile ParameterFile::parse(const std::string& text, const std::string& fileName) {
+  ParameterFile file;
+  file.fileName_ = fileName;
+  std::map<std::string, int> seen;
+  for (auto& line : internal::splitLines(text, fileName)) {
+    if (line.trimmed[0] == '[')
+      throw ConfigError(fileName, line.number, "sections ('[...]') are not allowed in a control-program file");
+    const std::string& name = line.words[0];
+    if (!internal::isIdentifier(name, false))
+      throw ConfigError(fileName, line.number, "'" + name + "' is not a valid parameter name");
+    if (line.words.size() < 2) throw ConfigError(fileName, line.number, "'" + name + "' has no value");
+    if (auto it = seen.find(name); it != seen.end())
+      throw ConfigError(fileName, line.number,
+                        "'" + name + "' is given twice (first at line " + std::to_string(it->second) + ")");
+    seen[name] = line.number;
+    ConfigSetting entry{name, {line.words.begin() + 1, line.words.end()}, line.number};
+    if (name != "log") {
+      for (const auto& v : entry.values) {
+        double d;
+        if (!internal::parseNumber(v, d) || !std::isfinite(d))
+          throw ConfigError(fileName, line.number, "'" + name + "': '" + v + "' is not a number");
+      }
+    }
+    file.entries_.push_back(std::move(entry));
+  }
+  return file;
+}
+
+ConfigError ParameterFile::errorAt(const ConfigSetting& entry, const std::string& message) const {
+  return ConfigError(fileName_, entry.line, message);
+}
+
+// ---- ConfigSection ---------------------------------------------------------------------------
+
+const ConfigSetting* ConfigSection::find(const std::string& name) const {
+  for (const auto& s : settings_)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+std::vector<double> ConfigSection::getNumbers(const std::string& name) const {
+  const ConfigSetting* s = find(name);
+  if (!s) throw ConfigError(fileName_, line_, "section [" + name_ + "] has no setting '" + name + "'");
+  std::vector<double> out;
+  for (const auto& v : s->values) {
+    double d;
+    if (!internal::parseNumber(v, d) || !std::isfinite(d))
+      throw errorAt(*s, "setting '" + name + "': '" + v + "' is not a number");
+    out.push_back(d);
+  }
+  return out;
+}
+
+std::string ConfigSection::getWord(const std::string& name) const {
+  const ConfigSetting* s = find(name);
+  if (!s) throw ConfigError(fileName_, line_, "section [" + name_ + "] has no setting '" + name + "'");
+  if (s->values.empty()) throw errorAt(*s, "setting '" + name + "' has no value");
+  return s->values[0];
+}
+
+ConfigError ConfigSection::errorAt(const ConfigSetting& setting, const std::string& message) const {
+  return ConfigError(fileName_, setting.line, message);
+}
+
+// ---- Configuration ---------------------------------------------------------------------------
+
+Configuration Configuration::read(const std::string& fileName, const Options& options) {
+  return parse(internal::readTextFile(fileName), fileName, options);
+}
+
+Configuration Configuration::parse(const std::string& text, const std::string& fileName, const Options& options) {
+  Configuration cfg;
+  cfg.fileName_ = fileName;
+  ConfigSection* current = nullptr;
+  std::map<std::string, int> sectionLines;
+  std::map<std::string, int> settingLines;  // of the current section
+
+  auto finishSection = [&] {
+    if (current && current->className_.empty())
+      throw ConfigError(fileName, current->line_, "section [" + current->name_ + "] has no 'class' setting");
+  };
+
+  for (auto& line : internal::splitLines(text, fileName)) {
+    if (line.trimmed[0] == '[') {
+      std::size_t close = line.trimmed.find(']');
+      if (close == std::string::npos)
+        throw ConfigError(fileName, line.number, "section header '" + line.trimmed + "' is missing ']'");
+      std::string rest = line.trimmed.substr(close + 1);
+      rest.erase(0, rest.find_first_not_of(" \t\r\f\v") == std::string::npos ? rest.size()
+                                                                            : rest.find_first_not_of(" \t\r\f\v"));
+      std::string name = line.trimmed.substr(1, close - 1);
+      auto notSpace = [](char c) { return !internal::isSpace(c); };
+      name.erase(name.begin(), std::find_if(name.begin(), name.end(), notSpace));
+      name.erase(std::find_if(name.rbegin(), name.rend(), notSpace).base(), name.end());
+      if (!rest.empty())
+        throw ConfigError(fileName, line.number, "unexpected text '" + rest + "' after section header [" + name + "]");
+      if (name.empty()) throw ConfigError(fileName, line.number, "empty section name '[]'");
+      if (!internal::isIdentifier(name, true))
+        throw ConfigError(fileName, line.number,
+                          "section name '" + name +
+                              "' must start with a letter or '_' and contain only letters, digits, '_' and '-'");
+      finishSection();
+      if (auto it = sectionLines.find(name); it != sectionLines.end())
+        throw ConfigError(fileName, line.number,
+                          "duplicate section [" + name + "] (first at line " + std::to_string(it->second) + ")");
+      sectionLines[name] = line.number;
+      settingLines.clear();
+      cfg.sections_.emplace_back();
+      current = &cfg.sections_.back();
+      current->name_ = name;
+      current->fileName_ = fileName;
+      current->line_ = line.number;
+      continue;
+    }
+    const std::string& name = line.words[0];
+    ConfigSetting setting{name, {line.words.begin() + 1, line.words.end()}, line.number};
+    if (!current) {
+      if (name == "plugin") {
+        if (setting.values.size() != 1)
+          throw ConfigError(fileName, line.number,
+                            "setting 'plugin' needs 1 value (a shared library path), got " +
+                                std::to_string(setting.values.size()));
+        setting.values[0] = internal::resolvePath(fileName, setting.values[0]);
+        cfg.plugins_.push_back(std::move(setting));
+        continue;
+      }
+      throw ConfigError(fileName, line.number,
+                        "setting '" + name + "' is outside a section (start one with a [name] line)");
+    }
+    if (!internal::isIdentifier(name, false))
+      throw ConfigError(fileName, line.number, "'" + name + "' is not a valid setting name");
+    if (auto it = settingLines.find(name); it != settingLines.end())
+      throw ConfigError(fileName, line.number,
+                        "setting '" + name + "' is given twice in [" + current->name_ + "] (first at line " +
+                            std::to_string(it->second) + ")");
+    settingLines[name] = line.number;
+    if (name == "class") {
+      if (setting.values.size() != 1)
+        throw ConfigError(fileName, line.number,
+                          "setting 'class' needs 1 value (a class name), got " + std::to_string(setting.values.size()));
+      current->className_ = setting.values[0];
+      current->classLine_ = line.number;
+      continue;
+    }
+    if (name == "qmotorConfig") {
+      if (setting.values.size() != 1)
+        throw ConfigError(fileName, line.number,
+                          "setting 'qmotorConfig' needs 1 value (a file name), got " +
+                              std::to_string(setting.values.size()));
+      if (options.readQMotorFiles) {
+        const std::string path = internal::resolvePath(fileName, setting.values[0]);
+        std::string text;
+        try {
+          text = internal::readTextFile(path);
+        } catch (const ConfigError& e) {
+          throw ConfigError(fileName, line.number,
+                            "qmotorConfig file '" + setting.values[0] + "' " +
+                                (e.message().rfind("cannot read the file: ", 0) == 0
+                                     ? "cannot be read: " + e.message().substr(22)
+                                     : e.message()));
+        }
+        current->qmotor_ = std::make_shared<const ParameterFile>(ParameterFile::parse(text, path));
+      }
+    }
+    current->settings_.push_back(std::move(setting));
+  }
+  finishSection();
+
+  if (options.loadPlugins) {
+    for (const auto& p : cfg.plugins_) {
+      if (!dlopen(p.values[0].c_str(), RTLD_NOW | RTLD_GLOBAL)) {
+        const char* err = dlerror();
+        throw ConfigError(fileName, p.line,
+                          "plugin '" + p.values[0] + "' cannot be loaded: " + (err ? err : "unknown error"));
+      }
+    }
+  }
+  if (options.checkClasses) {
+    const TypeDatabase& db = TypeDatabase::instance();
+    for (const auto& section : cfg.sections_) {
+      const TypeInfo* type = db.find(section.className_);
+      if (!type)
+        throw ConfigError(fileName, section.classLine_,
+                          "class '" + section.className_ + "' is not known (known: " + db.knownNames() + ")");
+      for (const auto& s : section.settings_) {
+        if (s.name == "qmotorConfig") continue;
+        const SettingSpec* spec = type->schema.find(s.name);
+        if (!spec)
+          throw ConfigError(fileName, s.line,
+                            "setting '" + s.name + "' is not known for class " + section.className_ +
+                                " (known: " + type->schema.knownNames() + ")");
+        internal::checkSetting(*spec, s, fileName);
+      }
+    }
+  }
+  return cfg;
+}
+
+const ConfigSection* Configuration::findSection(const std::string& name) const {
+  for (const auto& s : sections_)
+    if (s.name() == name) return &s;
+  return nullptr;
+}
+
+std::string Configuration::sectionNames() const {
+  std::vector<std::string> names;
+  for (const auto& s : sections_) names.push_back(s.name());
+  return names.empty() ? std::string("none") : internal::joinWords(names, ", ");
+}
+
+}  // namespace rp

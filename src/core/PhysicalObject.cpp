@@ -1,0 +1,109 @@
+// PhysicalObject: pose, connection, simulation and display modes, default 3D model.
+#include "rp/core/PhysicalObject.hpp"
+
+#include <cmath>
+#include <mutex>
+
+#include "rp/core/RoboticPlatform.hpp"
+
+namespace rp {
+
+struct PhysicalObject::Impl {
+  mutable std::mutex mutex;
+  Transform transform = Transform::unit();
+  PhysicalObject* connection = nullptr;
+  std::string connectionFrame = "base";
+  // -1: follow the platform; 0: off; 1: on.
+  std::atomic<int> simulation{-1};
+  std::atomic<int> display{static_cast<int>(DisplayMode::Solid)};
+};
+
+PhysicalObject::PhysicalObject(const std::string& name) : RoboticObject(name), pimpl_(std::make_unique<Impl>()) {
+  const ConfigSection* section = configSection();
+  if (!section) return;
+  // rp.cfg units: position in millimetres, orientation (roll, pitch, yaw) in degrees.
+  Vector<3> p;
+  Vector<3> rpy;
+  if (section->has("position")) {
+    auto v = section->getNumbers("position");
+    if (v.size() != 3) throw section->errorAt(*section->find("position"), "setting 'position' needs 3 values");
+    p = v[0] / 1000.0, v[1] / 1000.0, v[2] / 1000.0;
+  }
+  if (section->has("orientation")) {
+    auto v = section->getNumbers("orientation");
+    if (v.size() != 3) throw section->errorAt(*section->find("orientation"), "setting 'orientation' needs 3 values");
+    rpy = v[0] * M_PI / 180.0, v[1] * M_PI / 180.0, v[2] * M_PI / 180.0;
+  }
+  pimpl_->transform = translation(p) * rpyToTransform(rpy(0), rpy(1), rpy(2));
+  if (section->has("simulationMode")) pimpl_->simulation = section->getWord("simulationMode") == "on" ? 1 : 0;
+  if (section->has("display")) {
+    std::string d = section->getWord("display");
+    pimpl_->display = static_cast<int>(d == "off" ? DisplayMode::Off : d == "wireframe" ? DisplayMode::Wireframe
+                                                                                          : DisplayMode::Solid);
+  }
+}
+
+PhysicalObject::~PhysicalObject() = default;
+
+void PhysicalObject::declareSettings(SettingSchema& schema) {
+  RoboticObject::declareSettings(schema);
+  schema.addNumbers("position", 3, "mm", "x y z");
+  schema.addNumbers("orientation", 3, "deg", "roll pitch yaw");
+  schema.addChoice("simulationMode", {"on", "off"}, "simulate instead of using the hardware");
+  schema.addChoice("display", {"off", "solid", "wireframe"}, "how the Scene Viewer shows the object");
+}
+
+Model3D PhysicalObject::get3DModel() const {
+  Model3D model;
+  Shape cube;
+  cube.kind = ShapeKind::Box;
+  cube.size = Vector<3>::Constant(0.1);
+  model.shapes.push_back(cube);
+  return model;
+}
+
+void PhysicalObject::setConnection(PhysicalObject& mount, const std::string& frame) {
+  std::lock_guard<std::mutex> lock(pimpl_->mutex);
+  pimpl_->connection = &mount;
+  pimpl_->connectionFrame = frame;
+}
+
+void PhysicalObject::clearConnection() {
+  std::lock_guard<std::mutex> lock(pimpl_->mutex);
+  pimpl_->connection = nullptr;
+  pimpl_->connectionFrame = "base";
+}
+
+PhysicalObject* PhysicalObject::getConnection() const {
+  std::lock_guard<std::mutex> lock(pimpl_->mutex);
+  return pimpl_->connection;
+}
+
+std::string PhysicalObject::getConnectionFrame() const {
+  std::lock_guard<std::mutex> lock(pimpl_->mutex);
+  return pimpl_->connectionFrame;
+}
+
+void PhysicalObject::setTransform(const Transform& t) {
+  std::lock_guard<std::mutex> lock(pimpl_->mutex);
+  pimpl_->transform = t;
+}
+
+Transform PhysicalObject::getTransform() const {
+  std::lock_guard<std::mutex> lock(pimpl_->mutex);
+  return pimpl_->transform;
+}
+
+void PhysicalObject::setSimulationModeOn() { pimpl_->simulation = 1; }
+void PhysicalObject::setSimulationModeOff() { pimpl_->simulation = 0; }
+
+bool PhysicalObject::isSimulationModeOn() const {
+  if (RoboticPlatform::isSimulationModeForced()) return true;
+  const int own = pimpl_->simulation.load();
+  return own < 0 ? RoboticPlatform::isSimulationModeOn() : own == 1;
+}
+
+void PhysicalObject::setDisplayMode(DisplayMode mode) { pimpl_->display = static_cast<int>(mode); }
+DisplayMode PhysicalObject::getDisplayMode() const { return static_cast<DisplayMode>(pimpl_->display.load()); }
+
+}  // namespace rp

@@ -1,0 +1,208 @@
+// RoboticObject: registration, name, error status, commands, shutdown, GUI defaults.
+#include "rp/core/RoboticObject.hpp"
+
+#include <cxxabi.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <thread>
+#include <typeindex>
+
+#include "Registry.hpp"
+#include "rp/core/ObjectManager.hpp"
+#include "rp/core/PhysicalObject.hpp"
+#include "rp/core/TypeDatabase.hpp"
+#include "rp/rt/ControlProgram.hpp"
+
+namespace rp {
+
+namespace internal {
+
+std::string demangleName(const char* mangled) {
+  int status = 0;
+  char* d = abi::__cxa_demangle(mangled, nullptr, nullptr, &status);
+  std::string name = (status == 0 && d) ? d : mangled;
+  std::free(d);
+  // Drop namespaces (but keep template arguments intact).
+  std::size_t angle = name.find('<');
+  std::size_t colon = name.rfind("::", angle == std::string::npos ? std::string::npos : angle);
+  if (colon != std::string::npos) name = name.substr(colon + 2);
+  return name;
+}
+
+}  // namespace internal
+
+struct RoboticObject::Impl {
+  std::string name;
+  std::uint64_t id = 0;
+  std::shared_ptr<const Configuration> configuration;  // keeps `section` alive
+  const ConfigSection* section = nullptr;
+
+  // Error status: a tiny spin lock taken with a bounded number of attempts by writers.
+  mutable std::atomic_flag errorLock = ATOMIC_FLAG_INIT;
+  std::atomic<int> errorCode{0};
+  char errorMessage[256] = {};
+
+  std::atomic<bool> shuttingDown{false};
+  std::atomic<bool> shutdownComplete{false};
+
+  std::mutex commandMutex;
+  struct Command {
+    std::string name, description;
+    std::function<void()> action;
+  };
+  std::vector<Command> commands;
+};
+
+RoboticObject::RoboticObject(const std::string& name) : impl_(std::make_unique<Impl>()) {
+  auto& reg = internal::registry();
+  impl_->name = name;
+  impl_->configuration = internal::currentConfiguration();
+  if (!name.empty()) impl_->section = impl_->configuration->findSection(name);
+  {
+    std::lock_guard<std::recursive_mutex> lock(reg.mutex);
+    if (!name.empty())
+      for (RoboticObject* o : reg.objects)
+        if (!o->impl_->name.empty() && o->impl_->name == name)
+          throw std::invalid_argument("RoboticObject: an object named '" + name + "' already exists");
+    impl_->id = reg.nextId.fetch_add(1);
+    reg.objects.push_back(this);
+  }
+  internal::ensureShutdownWatcher();
+}
+
+RoboticObject::~RoboticObject() {
+  auto& reg = internal::registry();
+  std::lock_guard<std::recursive_mutex> lock(reg.mutex);
+  reg.objects.erase(std::remove(reg.objects.begin(), reg.objects.end(), this), reg.objects.end());
+}
+
+void RoboticObject::declareSettings(SettingSchema&) {}
+
+std::string RoboticObject::getName() const {
+  if (!impl_->name.empty()) return impl_->name;
+  std::string cls = getClassName();
+  std::transform(cls.begin(), cls.end(), cls.begin(), [](unsigned char c) {
+    return std::isalnum(c) ? static_cast<char>(std::tolower(c)) : '_';
+  });
+  return cls + "_" + std::to_string(impl_->id);
+}
+
+bool RoboticObject::hasAutomaticName() const noexcept { return impl_->name.empty(); }
+
+std::string RoboticObject::getClassName() const {
+  if (const TypeInfo* info = TypeDatabase::instance().find(std::type_index(typeid(*this)))) return info->name;
+  return internal::demangleName(typeid(*this).name());
+}
+
+const ConfigSection* RoboticObject::configSection() const noexcept { return impl_->section; }
+
+void RoboticObject::setError(int code, const char* message) noexcept {
+  // Bounded attempts: a real-time writer never waits long for a non-real-time one.
+  for (int attempt = 0; attempt < 1000; ++attempt) {
+    if (!impl_->errorLock.test_and_set(std::memory_order_acquire)) {
+      std::size_t n = message ? std::strlen(message) : 0;
+      n = std::min(n, sizeof(impl_->errorMessage) - 1);
+      if (n) std::memcpy(impl_->errorMessage, message, n);
+      impl_->errorMessage[n] = '\0';
+      impl_->errorCode.store(code, std::memory_order_relaxed);
+      impl_->errorLock.clear(std::memory_order_release);
+      return;
+    }
+  }
+  impl_->errorCode.store(code, std::memory_order_relaxed);  // message dropped, code kept
+}
+
+int RoboticObject::getErrorCode() const noexcept { return impl_->errorCode.load(std::memory_order_relaxed); }
+
+ErrorStatus RoboticObject::getErrorStatus() const {
+  while (impl_->errorLock.test_and_set(std::memory_order_acquire)) std::this_thread::yield();
+  ErrorStatus status{impl_->errorCode.load(std::memory_order_relaxed), impl_->errorMessage};
+  impl_->errorLock.clear(std::memory_order_release);
+  return status;
+}
+
+void RoboticObject::addCommand(const std::string& name, std::function<void()> action, const std::string& description) {
+  std::lock_guard<std::mutex> lock(impl_->commandMutex);
+  for (const auto& c : impl_->commands)
+    if (c.name == name) throw std::invalid_argument("addCommand: '" + name + "' is already a command of " + getName());
+  impl_->commands.push_back({name, description, std::move(action)});
+}
+
+std::vector<CommandInfo> RoboticObject::getCommands() const {
+  std::lock_guard<std::mutex> lock(impl_->commandMutex);
+  std::vector<CommandInfo> out;
+  for (const auto& c : impl_->commands) out.push_back({c.name, c.description});
+  return out;
+}
+
+void RoboticObject::executeCommand(const std::string& name) {
+  std::function<void()> action;
+  {
+    std::lock_guard<std::mutex> lock(impl_->commandMutex);
+    std::string known;
+    for (const auto& c : impl_->commands) {
+      if (c.name == name) action = c.action;
+      known += (known.empty() ? "" : ", ") + c.name;
+    }
+    if (!action)
+      throw std::invalid_argument("executeCommand: " + getName() + " has no command '" + name +
+                                  "' (known: " + (known.empty() ? "none" : known) + ")");
+  }
+  action();
+}
+
+void RoboticObject::startShutdown() {
+  impl_->shuttingDown.store(true);
+  if (ControlProgram* p = getControlProgram()) p->requestStop();
+  setShutdownComplete();
+}
+
+bool RoboticObject::isShutdownComplete() const { return impl_->shutdownComplete.load(); }
+
+bool RoboticObject::isShuttingDown() const noexcept { return impl_->shuttingDown.load(); }
+
+void RoboticObject::setShutdownComplete() noexcept {
+  impl_->shuttingDown.store(true);
+  impl_->shutdownComplete.store(true);
+}
+
+void RoboticObject::requestSystemShutdown(const char* reason) noexcept { ObjectManager::requestSystemShutdown(reason); }
+
+ControlPanel RoboticObject::getControlPanel() const {
+  ControlPanel panel;
+  panel.title = getName() + " (" + getClassName() + ")";
+  ControlPanelField error;
+  error.name = "errorCode";
+  error.label = "Error code";
+  error.kind = FieldKind::Number;
+  panel.fields.push_back(error);
+  return panel;
+}
+
+bool RoboticObject::getStateSnapshot(StateSnapshot&) const { return false; }
+
+bool RoboticObject::handleMessage(const std::string&, const std::string&, std::string& reply) {
+  reply.clear();
+  return false;
+}
+
+void RoboticObject::startControlLoop() {
+  if (ControlProgram* p = getControlProgram()) {
+    if (p->getProgramName() == "control") p->setProgramName(getName());
+    if (!p->isRunning()) p->start();
+  }
+}
+
+void RoboticObject::stopControlLoop() {
+  if (ControlProgram* p = getControlProgram()) p->stop();
+}
+
+ObjectInfo RoboticObject::getInfo() {
+  return ObjectInfo{getName(), getClassName(), dynamic_cast<PhysicalObject*>(this) != nullptr, needsControlLoop()};
+}
+
+}  // namespace rp

@@ -1,0 +1,245 @@
+// RoboticPlatform: command line (Table 3), configuration loading, signals, start-up and exit.
+#include "rp/core/RoboticPlatform.hpp"
+
+#include <signal.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <mutex>
+#include <stdexcept>
+
+#include "Registry.hpp"
+#include "rp/core/ObjectManager.hpp"
+#include "rp/rt/Clock.hpp"
+#include "rp/rt/ControlProgram.hpp"
+#include "rp/rt/LogWriter.hpp"
+
+namespace rp {
+
+namespace {
+
+struct PlatformState {
+  std::mutex mutex;
+  std::string configFile = "rp.cfg";
+  bool configFileGiven = false;
+  std::string logFile;
+  std::function<void()> guiStarter;
+  std::atomic<int> simulation{-1};  // -1 default (on), 0 -nosim, 1 -sim (forced)
+  std::atomic<bool> gui{true};
+  std::atomic<bool> qmotor{false};
+  std::atomic<bool> simulatedClock{false};
+  std::atomic<bool> initialized{false};
+};
+
+PlatformState& state() {
+  static PlatformState* s = new PlatformState;  // never destroyed (used by exit handlers)
+  return *s;
+}
+
+SimulatedClock& platformSimulatedClock() {
+  static SimulatedClock* c = new SimulatedClock(1e-4);
+  return *c;
+}
+
+void onSignal(int sig) {
+  signal(sig, SIG_DFL);  // a second signal ends the process at once
+  auto& reg = internal::registry();
+  reg.signalNumber.store(sig);
+  ObjectManager::requestSystemShutdown(sig == SIGINT ? "SIGINT received" : "SIGTERM received");
+}
+
+void atExit() { RoboticPlatform::finish(); }
+
+}  // namespace
+
+std::string RoboticPlatform::usage() {
+  return "Robotic Platform switches:\n"
+         "  -sim               simulation mode on for every object\n"
+         "  -nosim             use the hardware (objects may still set simulationMode on)\n"
+         "  -gui | -nogui      start the Scene Viewer or not (default: start it)\n"
+         "  -config <file>     global configuration file (default: rp.cfg)\n"
+         "  -qmotor            open the tuning window\n"
+         "  -log <file>        log every log variable of every control program to one CSV file\n"
+         "  -simclock          run control programs on a simulated clock, as fast as possible\n"
+         "  --help             print this text and exit\n"
+         "Arguments after -- and --long options are left for the program.\n";
+}
+
+std::vector<std::string> RoboticPlatform::parseCommandLine(const std::vector<std::string>& args) {
+  std::vector<std::string> rest;
+  auto& s = state();
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--") {
+      rest.insert(rest.end(), args.begin() + static_cast<long>(i), args.end());
+      break;
+    }
+    auto value = [&](const char* what) -> std::string {
+      if (i + 1 >= args.size() || args[i + 1].empty())
+        throw std::invalid_argument("switch '" + a + "' needs a value (" + what + ")");
+      return args[++i];
+    };
+    if (a == "-sim") setSimulationModeOn();
+    else if (a == "-nosim") setSimulationModeOff();
+    else if (a == "-gui") setGuiOn();
+    else if (a == "-nogui") setGuiOff();
+    else if (a == "-qmotor") setQMotorOn();
+    else if (a == "-simclock") useSimulatedClock();
+    else if (a == "-config") setConfigurationFileName(value("a file name"));
+    else if (a == "-log") setLogFileName(value("a CSV file name"));
+    else if (a == "--help" || a == "-help" || a == "-h") throw std::invalid_argument("--help");
+    else if (a.size() >= 2 && a[0] == '-' && a[1] != '-' && !(a[1] >= '0' && a[1] <= '9') && a[1] != '.')
+      throw std::invalid_argument("unknown platform switch '" + a +
+                                  "' (known: -sim, -nosim, -gui, -nogui, -config, -qmotor, -log, -simclock, --help)");
+    else
+      rest.push_back(a);
+  }
+  (void)s;
+  return rest;
+}
+
+void RoboticPlatform::init(int& argc, char** argv, const std::string& programUsage) {
+  auto& s = state();
+  const std::string program = argc > 0 && argv && argv[0] ? std::filesystem::path(argv[0]).filename().string() : "rp";
+  std::vector<std::string> args;
+  for (int i = 1; i < argc; ++i) args.emplace_back(argv[i]);
+  std::vector<std::string> rest;
+  try {
+    rest = parseCommandLine(args);
+  } catch (const std::invalid_argument& e) {
+    if (std::string(e.what()) == "--help") {
+      std::cout << "usage: " << program << " [switches] [program arguments]\n" << usage();
+      if (!programUsage.empty()) std::cout << programUsage << (programUsage.back() == '\n' ? "" : "\n");
+      std::exit(0);
+    }
+    std::cerr << program << ": " << e.what() << "\n";
+    std::exit(2);
+  }
+  // Remove the platform switches; keep the program's arguments in order (argv[argc] stays null).
+  int out = 1;
+  for (int i = 1; i < argc; ++i) {
+    if (out - 1 < static_cast<int>(rest.size()) && rest[static_cast<std::size_t>(out - 1)] == argv[i]) argv[out++] = argv[i];
+  }
+  argc = out;
+  if (argv) argv[argc] = nullptr;
+
+  try {
+    loadConfiguration();
+  } catch (const ConfigError& e) {
+    std::cerr << e.what() << "\n";
+    std::exit(2);
+  }
+  // Simulation is the default when no hardware is configured.
+  if (s.simulation.load() < 0) {
+    bool hardware = false;
+    for (const auto& section : getConfiguration().sections())
+      if (const ConfigSetting* sim = section.find("simulationMode"); sim && sim->values == std::vector<std::string>{"off"})
+        hardware = true;
+    if (!hardware) std::cerr << "rp: no hardware configured: every object runs in simulation mode (-nosim to change)\n";
+  }
+  s.initialized = true;
+  internal::ensureShutdownWatcher();
+  signal(SIGINT, onSignal);
+  signal(SIGTERM, onSignal);
+  std::atexit(atExit);
+  if (!getLogFileName().empty()) {
+    try {
+      LogWriter::openPlatformWriter(getLogFileName());
+    } catch (const std::exception& e) {
+      std::cerr << program << ": -log: " << e.what() << "\n";
+      std::exit(2);
+    }
+  }
+  std::function<void()> starter;
+  {
+    std::lock_guard<std::mutex> lock(s.mutex);
+    starter = s.guiStarter;
+  }
+  if (isGuiOn() && starter) starter();
+}
+
+bool RoboticPlatform::isInitialized() { return state().initialized.load(); }
+
+void RoboticPlatform::setSimulationModeOn() { state().simulation = 1; }
+void RoboticPlatform::setSimulationModeOff() { state().simulation = 0; }
+bool RoboticPlatform::isSimulationModeOn() { return state().simulation.load() != 0; }
+bool RoboticPlatform::isSimulationModeForced() { return state().simulation.load() == 1; }
+void RoboticPlatform::setGuiOn() { state().gui = true; }
+void RoboticPlatform::setGuiOff() { state().gui = false; }
+bool RoboticPlatform::isGuiOn() { return state().gui.load(); }
+void RoboticPlatform::setQMotorOn() { state().qmotor = true; }
+bool RoboticPlatform::isQMotorOn() { return state().qmotor.load(); }
+
+void RoboticPlatform::setConfigurationFileName(const std::string& fileName) {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  state().configFile = fileName;
+  state().configFileGiven = true;
+}
+
+std::string RoboticPlatform::getConfigurationFileName() {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  return state().configFile;
+}
+
+void RoboticPlatform::setLogFileName(const std::string& fileName) {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  state().logFile = fileName;
+}
+
+std::string RoboticPlatform::getLogFileName() {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  return state().logFile;
+}
+
+void RoboticPlatform::useSimulatedClock() { state().simulatedClock = true; }
+void RoboticPlatform::useRealClock() { state().simulatedClock = false; }
+
+Clock& RoboticPlatform::getDefaultClock() {
+  if (state().simulatedClock.load()) return platformSimulatedClock();
+  return RealClock::instance();
+}
+
+void RoboticPlatform::loadConfiguration() {
+  std::string file;
+  bool given;
+  {
+    std::lock_guard<std::mutex> lock(state().mutex);
+    file = state().configFile;
+    given = state().configFileGiven;
+  }
+  std::error_code ec;
+  if (!given && !std::filesystem::exists(file, ec)) {
+    setConfiguration(Configuration());
+    return;
+  }
+  setConfiguration(Configuration::read(file));
+}
+
+void RoboticPlatform::setConfiguration(const Configuration& configuration) {
+  auto& reg = internal::registry();
+  auto copy = std::make_shared<const Configuration>(configuration);
+  std::lock_guard<std::mutex> lock(reg.configMutex);
+  reg.configuration = std::move(copy);
+}
+
+const Configuration& RoboticPlatform::getConfiguration() {
+  // The registry keeps every configuration that objects still use alive through their own
+  // shared pointers; the current one lives until it is replaced.
+  return *internal::currentConfiguration();
+}
+
+void RoboticPlatform::setGuiStarter(std::function<void()> starter) {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  state().guiStarter = std::move(starter);
+}
+
+void RoboticPlatform::finish() {
+  ObjectManager().deleteAllObjects();
+  ControlProgram::stopAll();
+  LogWriter::closePlatformWriter();
+}
+
+}  // namespace rp

@@ -1,0 +1,638 @@
+// ControlProgram: the periodic loop, its statistics, log sampling and tunable parameters.
+#include "rp/rt/ControlProgram.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include "LogChannel.hpp"
+#include "rp/core/Configuration.hpp"
+#include "rp/core/ObjectManager.hpp"
+#include "rp/core/RoboticPlatform.hpp"
+#include "rp/rt/Clock.hpp"
+#include "rp/rt/LogWriter.hpp"
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define RP_UNDER_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define RP_UNDER_SANITIZER 1
+#endif
+#endif
+
+namespace rp {
+
+namespace internal {
+
+std::int64_t monotonicNanoseconds() noexcept;
+void ensureShutdownWatcher();
+
+namespace {
+
+constexpr std::size_t kBins = 10000;  // 1 µs histogram bins; the last one holds everything above
+
+// Durations in nanoseconds: min, max, sum and a 1 µs histogram, written by one thread.
+struct DurationStats {
+  std::atomic<std::uint64_t> count{0}, sum{0}, min{std::numeric_limits<std::uint64_t>::max()}, max{0};
+  std::unique_ptr<std::atomic<std::uint32_t>[]> bins{new std::atomic<std::uint32_t>[kBins + 1]};
+  DurationStats() { reset(); }
+  void reset() {
+    count = 0;
+    sum = 0;
+    min = std::numeric_limits<std::uint64_t>::max();
+    max = 0;
+    for (std::size_t i = 0; i <= kBins; ++i) bins[i].store(0, std::memory_order_relaxed);
+  }
+  void add(std::int64_t ns) noexcept {
+    const auto v = static_cast<std::uint64_t>(ns < 0 ? 0 : ns);
+    count.store(count.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    sum.store(sum.load(std::memory_order_relaxed) + v, std::memory_order_relaxed);
+    if (v < min.load(std::memory_order_relaxed)) min.store(v, std::memory_order_relaxed);
+    if (v > max.load(std::memory_order_relaxed)) max.store(v, std::memory_order_relaxed);
+    const std::size_t bin = std::min<std::uint64_t>(v / 1000, kBins);
+    bins[bin].store(bins[bin].load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  }
+  LatencyStatistics summary() const {
+    LatencyStatistics s;
+    s.count = count.load();
+    if (s.count == 0) return s;
+    s.min = static_cast<double>(min.load()) / 1000.0;
+    s.max = static_cast<double>(max.load()) / 1000.0;
+    s.mean = static_cast<double>(sum.load()) / static_cast<double>(s.count) / 1000.0;
+    auto percentile = [&](double p) {
+      const auto target = static_cast<std::uint64_t>(std::ceil(p * static_cast<double>(s.count)));
+      std::uint64_t seen = 0;
+      for (std::size_t i = 0; i <= kBins; ++i) {
+        seen += bins[i].load(std::memory_order_relaxed);
+        if (seen >= target) return std::clamp(static_cast<double>(i) + 0.5, s.min, s.max);  // bin middle
+      }
+      return s.max;
+    };
+    s.p50 = percentile(0.50);
+    s.p99 = percentile(0.99);
+    return s;
+  }
+};
+
+std::mutex& programsMutex() {
+  static std::mutex* m = new std::mutex;
+  return *m;
+}
+std::vector<ControlProgram*>& programs() {
+  static auto* v = new std::vector<ControlProgram*>;
+  return *v;
+}
+
+std::atomic<bool> schedulingWarned{false};
+std::once_flag memoryLocked;
+
+}  // namespace
+}  // namespace internal
+
+struct ControlProgram::Impl {
+  explicit Impl(ControlProgram& p) : self(p) {}
+  ControlProgram& self;
+  std::string name;
+  double rate = 1000.0;
+  int priority = 27;
+  Clock* clock = nullptr;
+  std::uint64_t cycleLimit = 0;
+
+  // Lifecycle.
+  std::mutex lifecycle;
+  std::thread thread;
+  std::thread::id threadId;
+  std::atomic<bool> running{false};
+  std::atomic<bool> stopRequested{false};
+  std::mutex endMutex;
+  std::condition_variable endCv;
+  bool ended = true;
+
+  // Cycle state.
+  std::atomic<double> time{0};
+  std::atomic<std::uint64_t> cycles{0};
+  std::atomic<std::uint64_t> overruns{0};
+  std::atomic<std::uint64_t> logSamples{0};
+  std::atomic<bool> realTime{false};
+  internal::DurationStats latency, computation;
+  SimulatedClock::Participant participant;
+
+  // Log variables.
+  struct LogVar {
+    LogVariableInfo info;
+    const double* data;
+    bool selected = true;
+  };
+  std::vector<LogVar> logVars;
+  unsigned logEvery = 1;
+  std::size_t logBufferSize = 4096;
+  LogWriter* writer = nullptr;
+  bool writerSet = false;
+  std::shared_ptr<LogWriter::Channel> channel;
+  std::vector<const double*> logSources;  // flattened, one per column (built in start())
+
+  // Parameters.
+  struct Param {
+    ParameterInfo info;
+    double* target;
+    std::unique_ptr<std::atomic<double>[]> pending;
+    std::vector<double> requested;       // guarded by paramMutex
+    std::atomic<std::uint64_t> seq{0};   // odd while a writer fills `pending`
+    std::atomic<bool> dirty{false};
+  };
+  std::mutex paramMutex;
+  std::vector<std::unique_ptr<Param>> params;
+
+  Param& findParam(const std::string& pname) {
+    for (auto& p : params)
+      if (p->info.name == pname) return *p;
+    std::string known;
+    for (auto& p : params) known += (known.empty() ? "" : ", ") + p->info.name;
+    throw std::invalid_argument("ControlProgram " + name + ": no parameter '" + pname + "' (known: " +
+                                (known.empty() ? "none" : known) + ")");
+  }
+
+  void checkNotRunning(const char* what) const {
+    if (running.load()) throw std::logic_error(std::string("ControlProgram::") + what + ": the program is running");
+  }
+
+  // Real-time: applies parameter changes requested since the last cycle, tear-free.
+  void applyParameters() noexcept {
+    for (auto& p : params) {
+      if (!p->dirty.load(std::memory_order_acquire)) continue;
+      const std::uint64_t s1 = p->seq.load(std::memory_order_acquire);
+      if (s1 & 1) continue;  // a writer is busy; try next cycle
+      p->dirty.store(false, std::memory_order_relaxed);
+      for (std::size_t i = 0; i < p->info.size; ++i) p->target[i] = p->pending[i].load(std::memory_order_relaxed);
+      std::atomic_thread_fence(std::memory_order_acquire);
+      if (p->seq.load(std::memory_order_relaxed) != s1) p->dirty.store(true, std::memory_order_relaxed);
+    }
+  }
+
+  void request(Param& p, const std::vector<double>& values) {
+    for (double v : values)
+      if (!(v >= p.info.min && v <= p.info.max))
+        throw std::out_of_range("ControlProgram " + name + ": parameter '" + p.info.name + "' = " + std::to_string(v) +
+                                " is outside [" + std::to_string(p.info.min) + ", " + std::to_string(p.info.max) + "]" +
+                                (p.info.unit.empty() ? "" : " " + p.info.unit));
+    std::lock_guard<std::mutex> lock(paramMutex);
+    p.requested = values;
+    if (!running.load()) {
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        p.target[i] = values[i];
+        p.pending[i].store(values[i], std::memory_order_relaxed);
+      }
+      return;
+    }
+    p.seq.fetch_add(1, std::memory_order_acq_rel);
+    for (std::size_t i = 0; i < values.size(); ++i) p.pending[i].store(values[i], std::memory_order_relaxed);
+    p.seq.fetch_add(1, std::memory_order_release);
+    p.dirty.store(true, std::memory_order_release);
+  }
+
+  // Real-time: one cycle at clock time t.
+  void cycle(double t, std::uint64_t k) noexcept {
+    time.store(t, std::memory_order_relaxed);
+    applyParameters();
+    self.control();
+    if (channel && k % logEvery == 0) {
+      if (double* slot = channel->beginPush()) {
+        slot[0] = t;
+        for (std::size_t i = 0; i < logSources.size(); ++i) slot[i + 1] = *logSources[i];
+        channel->commitPush();
+      }
+      logSamples.fetch_add(1, std::memory_order_relaxed);
+    }
+    cycles.fetch_add(1, std::memory_order_relaxed);
+  }
+
+  void setUpRealTime() {
+#ifndef RP_UNDER_SANITIZER
+    std::call_once(internal::memoryLocked, [] {
+      if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+        std::fprintf(stderr, "rp: mlockall failed (%s): memory may be paged out\n", std::strerror(errno));
+    });
+#endif
+    sched_param sp{};
+    sp.sched_priority = priority;
+    const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+    realTime = err == 0;
+    if (err != 0 && !internal::schedulingWarned.exchange(true))
+      std::fprintf(stderr,
+                   "rp: cannot use SCHED_FIFO priority %d (%s): control loops run with normal scheduling\n",
+                   priority, std::strerror(err));
+    // Touch the stack the loop will use so the first cycles do not page-fault.
+    volatile char stack[64 * 1024];
+    for (std::size_t i = 0; i < sizeof stack; i += 4096) stack[i] = 0;
+  }
+
+  void runReal() {
+    setUpRealTime();
+    const auto period = static_cast<std::int64_t>(std::llround(1e9 / rate));
+    const std::int64_t epoch = RealClock::instance().epochNanoseconds();
+    std::int64_t deadline = internal::monotonicNanoseconds();
+    std::uint64_t k = 0;
+    while (!stopRequested.load(std::memory_order_relaxed)) {
+      // Sleep until the absolute deadline, in slices so that stop() is never kept waiting long.
+      for (;;) {
+        const std::int64_t now = internal::monotonicNanoseconds();
+        if (now >= deadline || stopRequested.load(std::memory_order_relaxed)) break;
+        const std::int64_t until = std::min<std::int64_t>(deadline, now + 100000000LL);
+        timespec ts{static_cast<time_t>(until / 1000000000LL), static_cast<long>(until % 1000000000LL)};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+      }
+      if (stopRequested.load(std::memory_order_relaxed)) break;
+      const std::int64_t woke = internal::monotonicNanoseconds();
+      latency.add(woke - deadline);
+      cycle(static_cast<double>(deadline - epoch) * 1e-9, k++);
+      const std::int64_t done = internal::monotonicNanoseconds();
+      computation.add(done - woke);
+      deadline += period;
+      if (done > deadline) {  // overrun: skip the deadlines already missed
+        overruns.fetch_add(1, std::memory_order_relaxed);
+        deadline += ((done - deadline) / period + 1) * period;
+      }
+      if (cycleLimit && k >= cycleLimit) break;
+    }
+  }
+
+  void runSimulated(SimulatedClock& sim) {
+    const auto ticksPerCycle =
+        static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / rate / sim.getStep())));
+    std::uint64_t tick = (sim.getTick() + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle;
+    std::uint64_t k = 0;
+    while (sim.waitForTick(participant, tick, stopRequested)) {
+      const std::int64_t start = internal::monotonicNanoseconds();
+      cycle(sim.tickTime(tick), k++);
+      computation.add(internal::monotonicNanoseconds() - start);
+      tick += ticksPerCycle;
+      if (cycleLimit && k >= cycleLimit) break;
+    }
+  }
+
+  void threadMain() {
+    self.enterControl();
+    if (auto* sim = dynamic_cast<SimulatedClock*>(clock)) {
+      runSimulated(*sim);
+      sim->detach(participant);
+    } else {
+      runReal();
+    }
+    self.exitControl();
+    {
+      std::lock_guard<std::mutex> lock(endMutex);
+      ended = true;
+    }
+    endCv.notify_all();
+  }
+};
+
+ControlProgram::ControlProgram(const std::string& programName) : impl_(std::make_unique<Impl>(*this)) {
+  impl_->name = programName;
+  std::lock_guard<std::mutex> lock(internal::programsMutex());
+  internal::programs().push_back(this);
+}
+
+ControlProgram::~ControlProgram() {
+  stop();
+  std::lock_guard<std::mutex> lock(internal::programsMutex());
+  auto& v = internal::programs();
+  v.erase(std::remove(v.begin(), v.end(), this), v.end());
+}
+
+void ControlProgram::setProgramName(const std::string& name) {
+  impl_->checkNotRunning("setProgramName");
+  impl_->name = name;
+}
+const std::string& ControlProgram::getProgramName() const { return impl_->name; }
+
+void ControlProgram::setRate(double hz) {
+  impl_->checkNotRunning("setRate");
+  if (!(hz > 0) || !std::isfinite(hz))
+    throw std::invalid_argument("ControlProgram::setRate: the rate must be positive, got " + std::to_string(hz));
+  impl_->rate = hz;
+}
+double ControlProgram::getRate() const { return impl_->rate; }
+double ControlProgram::getPeriod() const { return 1.0 / impl_->rate; }
+
+void ControlProgram::setPriority(int priority) {
+  impl_->checkNotRunning("setPriority");
+  if (priority < 1 || priority > 99)
+    throw std::invalid_argument("ControlProgram::setPriority: the priority must be 1..99, got " + std::to_string(priority));
+  impl_->priority = priority;
+}
+int ControlProgram::getPriority() const { return impl_->priority; }
+
+void ControlProgram::setClock(Clock& clock) {
+  impl_->checkNotRunning("setClock");
+  impl_->clock = &clock;
+}
+Clock& ControlProgram::getClock() const { return impl_->clock ? *impl_->clock : RoboticPlatform::getDefaultClock(); }
+
+void ControlProgram::setCycleLimit(std::uint64_t cycles) {
+  impl_->checkNotRunning("setCycleLimit");
+  impl_->cycleLimit = cycles;
+}
+
+void ControlProgram::start() {
+  std::lock_guard<std::mutex> lock(impl_->lifecycle);
+  Impl& d = *impl_;
+  if (d.running.load() || d.thread.joinable()) throw std::logic_error("ControlProgram::start: " + d.name + " is already running");
+  internal::ensureShutdownWatcher();
+  if (!d.clock) d.clock = &RoboticPlatform::getDefaultClock();
+  d.stopRequested = false;
+  d.cycles = 0;
+  d.overruns = 0;
+  d.logSamples = 0;
+  d.latency.reset();
+  d.computation.reset();
+  // Log channel: one column per value of every selected variable.
+  d.channel.reset();
+  d.logSources.clear();
+  LogWriter* writer = d.writerSet ? d.writer : LogWriter::getPlatformWriter();
+  if (writer && !writer->isClosed()) {
+    std::vector<std::string> columns;
+    for (auto& v : d.logVars) {
+      if (!v.selected) continue;
+      for (std::size_t i = 0; i < v.info.size; ++i) {
+        std::string column = d.name;
+        column += '.';
+        column += v.info.name;
+        if (v.info.vector) {
+          column += '[';
+          column += std::to_string(i);
+          column += ']';
+        }
+        columns.push_back(std::move(column));
+        d.logSources.push_back(v.data + i);
+      }
+    }
+    if (!columns.empty()) {
+      d.channel = std::make_shared<LogWriter::Channel>(d.name, std::move(columns), d.logBufferSize);
+      writer->addChannel(d.channel);
+    }
+  }
+  d.writer = writer;
+  {
+    std::lock_guard<std::mutex> elock(d.endMutex);
+    d.ended = false;
+  }
+  if (auto* sim = dynamic_cast<SimulatedClock*>(d.clock)) sim->attach(d.participant);
+  d.running = true;
+  d.thread = std::thread([&d] { d.threadMain(); });
+  d.threadId = d.thread.get_id();
+}
+
+void ControlProgram::requestStop() noexcept {
+  impl_->stopRequested.store(true);
+  if (auto* sim = dynamic_cast<SimulatedClock*>(impl_->clock)) {
+    // interrupt() takes the clock's mutex; only the simulated clock needs the wake-up.
+    sim->interrupt();
+  }
+}
+
+void ControlProgram::stop() {
+  Impl& d = *impl_;
+  if (d.thread.joinable() && std::this_thread::get_id() == d.threadId) {
+    requestStop();
+    return;
+  }
+  std::lock_guard<std::mutex> lock(d.lifecycle);
+  if (!d.thread.joinable()) return;
+  requestStop();
+  d.thread.join();
+  d.running = false;
+  if (d.channel) {
+    d.channel->finished.store(true);
+    if (d.writer) d.writer->notify();
+  }
+}
+
+void ControlProgram::waitUntilStopped() {
+  {
+    std::unique_lock<std::mutex> lock(impl_->endMutex);
+    impl_->endCv.wait(lock, [&] { return impl_->ended; });
+  }
+  stop();
+}
+
+bool ControlProgram::isRunning() const noexcept { return impl_->running.load(); }
+double ControlProgram::getTime() const noexcept { return impl_->time.load(std::memory_order_relaxed); }
+std::uint64_t ControlProgram::getCycleCount() const noexcept { return impl_->cycles.load(std::memory_order_relaxed); }
+
+ControlStatistics ControlProgram::getStatistics() const {
+  ControlStatistics s;
+  s.cycles = impl_->cycles.load();
+  s.overruns = impl_->overruns.load();
+  s.wakeupLatency = impl_->latency.summary();
+  s.computationTime = impl_->computation.summary();
+  s.logSamples = impl_->logSamples.load();
+  s.lostLogSamples = impl_->channel ? impl_->channel->lost.load() : 0;
+  s.realTimeScheduling = impl_->realTime.load();
+  s.simulatedClock = impl_->clock && impl_->clock->isSimulated();
+  return s;
+}
+
+void ControlProgram::registerLogVariable(const std::string& name, const double& variable, const std::string& unit) {
+  registerLogVariable(name, &variable, 1, unit);
+  impl_->logVars.back().info.vector = false;
+}
+
+void ControlProgram::registerLogVariable(const std::string& name, const double* data, std::size_t size,
+                                         const std::string& unit) {
+  impl_->checkNotRunning("registerLogVariable");
+  if (name.empty() || name.find_first_of(",.\"\n[] ") != std::string::npos)
+    throw std::invalid_argument("registerLogVariable: '" + name + "' is not a valid name (no , . [ ] quotes or spaces)");
+  if (!data || size == 0) throw std::invalid_argument("registerLogVariable: '" + name + "' has no data");
+  for (auto& v : impl_->logVars)
+    if (v.info.name == name) throw std::invalid_argument("registerLogVariable: '" + name + "' is already registered");
+  impl_->logVars.push_back({LogVariableInfo{name, size, true, unit}, data, true});
+}
+
+std::vector<LogVariableInfo> ControlProgram::getLogVariables() const {
+  std::vector<LogVariableInfo> out;
+  for (auto& v : impl_->logVars) out.push_back(v.info);
+  return out;
+}
+
+void ControlProgram::setLogEvery(unsigned n) {
+  impl_->checkNotRunning("setLogEvery");
+  if (n == 0) throw std::invalid_argument("ControlProgram::setLogEvery: n must be at least 1");
+  impl_->logEvery = n;
+}
+unsigned ControlProgram::getLogEvery() const { return impl_->logEvery; }
+
+void ControlProgram::setLogBufferSize(std::size_t samples) {
+  impl_->checkNotRunning("setLogBufferSize");
+  if (samples < 2) throw std::invalid_argument("ControlProgram::setLogBufferSize: at least 2 samples");
+  impl_->logBufferSize = samples;
+}
+
+void ControlProgram::setLogWriter(LogWriter* writer) {
+  impl_->checkNotRunning("setLogWriter");
+  impl_->writer = writer;
+  impl_->writerSet = true;
+}
+
+void ControlProgram::registerParameter(const std::string& name, double& target, double min, double max,
+                                       const std::string& unit, const std::string& description) {
+  registerParameter(name, &target, 1, min, max, unit, description);
+}
+
+void ControlProgram::registerParameter(const std::string& name, double* target, std::size_t size, double min,
+                                       double max, const std::string& unit, const std::string& description) {
+  impl_->checkNotRunning("registerParameter");
+  if (name.empty() || !target || size == 0)
+    throw std::invalid_argument("registerParameter: '" + name + "' needs a name and storage");
+  if (!(min <= max)) throw std::invalid_argument("registerParameter: '" + name + "': min > max");
+  std::lock_guard<std::mutex> lock(impl_->paramMutex);
+  for (auto& p : impl_->params)
+    if (p->info.name == name) throw std::invalid_argument("registerParameter: '" + name + "' is already registered");
+  auto p = std::make_unique<Impl::Param>();
+  p->info = ParameterInfo{name, size, min, max, unit, description};
+  p->target = target;
+  p->pending.reset(new std::atomic<double>[size]);
+  for (std::size_t i = 0; i < size; ++i) {
+    if (!(target[i] >= min && target[i] <= max))
+      throw std::invalid_argument("registerParameter: '" + name + "': the current value " + std::to_string(target[i]) +
+                                  " is outside [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+    p->pending[i].store(target[i]);
+    p->requested.push_back(target[i]);
+  }
+  impl_->params.push_back(std::move(p));
+}
+
+void ControlProgram::setParameter(const std::string& name, double value) {
+  Impl::Param& p = impl_->findParam(name);
+  impl_->request(p, std::vector<double>(p.info.size, value));
+}
+
+void ControlProgram::setParameter(const std::string& name, std::size_t index, double value) {
+  Impl::Param& p = impl_->findParam(name);
+  if (index >= p.info.size)
+    throw std::out_of_range("ControlProgram " + impl_->name + ": parameter '" + name + "' has " +
+                            std::to_string(p.info.size) + " elements, index " + std::to_string(index) + " is too large");
+  std::vector<double> values;
+  {
+    std::lock_guard<std::mutex> lock(impl_->paramMutex);
+    values = p.requested;
+  }
+  values[index] = value;
+  impl_->request(p, values);
+}
+
+void ControlProgram::setParameter(const std::string& name, const std::vector<double>& values) {
+  Impl::Param& p = impl_->findParam(name);
+  if (values.size() != p.info.size)
+    throw std::invalid_argument("ControlProgram " + impl_->name + ": parameter '" + name + "' needs " +
+                                std::to_string(p.info.size) + " values, got " + std::to_string(values.size()));
+  impl_->request(p, values);
+}
+
+std::vector<double> ControlProgram::getParameter(const std::string& name) const {
+  Impl::Param& p = impl_->findParam(name);
+  std::lock_guard<std::mutex> lock(impl_->paramMutex);
+  return p.requested;
+}
+
+std::vector<ParameterInfo> ControlProgram::getParameters() const {
+  std::lock_guard<std::mutex> lock(impl_->paramMutex);
+  std::vector<ParameterInfo> out;
+  for (auto& p : impl_->params) out.push_back(p->info);
+  return out;
+}
+
+void ControlProgram::applyQMotorConfig(const ParameterFile& file) {
+  auto number = [&](const ConfigSetting& e) {
+    if (e.values.size() != 1) throw file.errorAt(e, "'" + e.name + "' needs 1 value, got " + std::to_string(e.values.size()));
+    return std::stod(e.values[0]);
+  };
+  for (const auto& e : file.entries()) {
+    try {
+      if (e.name == "rate") setRate(number(e));
+      else if (e.name == "priority") setPriority(static_cast<int>(number(e)));
+      else if (e.name == "logEvery") setLogEvery(static_cast<unsigned>(std::max(0.0, number(e))));
+      else if (e.name == "logBufferSize") setLogBufferSize(static_cast<std::size_t>(std::max(0.0, number(e))));
+      else if (e.name == "log") {
+        impl_->checkNotRunning("applyQMotorConfig");
+        for (auto& v : impl_->logVars) v.selected = false;
+        for (const auto& w : e.values) {
+          auto it = std::find_if(impl_->logVars.begin(), impl_->logVars.end(), [&](auto& v) { return v.info.name == w; });
+          if (it == impl_->logVars.end()) {
+            std::string known;
+            for (auto& v : impl_->logVars) known += (known.empty() ? "" : ", ") + v.info.name;
+            throw file.errorAt(e, "'log': '" + w + "' is not a log variable of " + impl_->name + " (known: " +
+                                      (known.empty() ? "none" : known) + ")");
+          }
+          it->selected = true;
+        }
+      } else {
+        bool known = false;
+        for (auto& p : impl_->params) known = known || p->info.name == e.name;
+        if (!known) {
+          std::string names = "rate, priority, logEvery, logBufferSize, log";
+          for (auto& p : impl_->params) names += ", " + p->info.name;
+          throw file.errorAt(e, "'" + e.name + "' is not a parameter of " + impl_->name + " (known: " + names + ")");
+        }
+        std::vector<double> values;
+        for (const auto& v : e.values) values.push_back(std::stod(v));
+        Impl::Param& p = impl_->findParam(e.name);
+        if (values.size() == 1 && p.info.size > 1) values.assign(p.info.size, values[0]);
+        setParameter(e.name, values);
+      }
+    } catch (const ConfigError&) {
+      throw;
+    } catch (const std::exception& ex) {
+      throw file.errorAt(e, ex.what());
+    }
+  }
+}
+
+void ControlProgram::saveQMotorConfig(const std::string& fileName) const {
+  std::ofstream out(fileName);
+  if (!out) throw std::runtime_error("saveQMotorConfig: cannot write '" + fileName + "'");
+  auto fmt = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
+  out << "# control-program file of " << impl_->name << "\n";
+  out << "rate " << fmt(impl_->rate) << "\n";
+  out << "priority " << impl_->priority << "\n";
+  out << "logEvery " << impl_->logEvery << "\n";
+  out << "logBufferSize " << impl_->logBufferSize << "\n";
+  std::string selected;
+  bool all = true;
+  for (auto& v : impl_->logVars) {
+    if (v.selected) selected += " " + v.info.name;
+    all = all && v.selected;
+  }
+  if (!all && !selected.empty()) out << "log" << selected << "\n";
+  std::lock_guard<std::mutex> lock(impl_->paramMutex);
+  for (auto& p : impl_->params) {
+    out << p->info.name;
+    for (double v : p->requested) out << " " << fmt(v);
+    out << "\n";
+  }
+  if (!out) throw std::runtime_error("saveQMotorConfig: error writing '" + fileName + "'");
+}
+
+void ControlProgram::stopAll() {
+  std::lock_guard<std::mutex> lock(internal::programsMutex());
+  for (ControlProgram* p : internal::programs()) p->stop();
+}
+
+}  // namespace rp

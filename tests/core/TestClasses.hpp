@@ -1,0 +1,58 @@
+// Classes registered only in the core tests: a physical and a functional object with settings of
+// every kind, and stand-ins for the paper's Figure 9 classes when the library has none yet.
+#pragma once
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
+#include "rp/core/Core.hpp"
+
+namespace rp::test {
+
+class TestArm : public PhysicalObject {
+ public:
+  explicit TestArm(const std::string& name = "") : PhysicalObject(name) {
+    if (const ConfigSection* s = configSection(); s && s->has("port")) port = s->getWord("port");
+  }
+  static void declareSettings(SettingSchema& schema) {
+    PhysicalObject::declareSettings(schema);
+    schema.addWord("port", "serial device");
+    schema.addNumbers("gain", 2, "N/m", "kp kd");
+    schema.addChoice("mode", {"fast", "slow"}, "speed");
+    schema.addInteger("count", "how many");
+  }
+  std::string port;
+};
+
+class TestFunction : public FunctionalObject {
+ public:
+  explicit TestFunction(const std::string& name = "") : FunctionalObject(name) {}
+};
+
+// Completes its shutdown only after isShutdownComplete() has been asked `delay` times.
+class SlowShutdown : public PhysicalObject {
+ public:
+  explicit SlowShutdown(const std::string& name = "") : PhysicalObject(name) {}
+  void startShutdown() override { started = true; }
+  bool isShutdownComplete() const override { return started && ++polls >= 3; }
+  std::atomic<bool> started{false};
+  mutable std::atomic<int> polls{0};
+};
+
+extern bool standInsRegistered;  // the Figure 9 stand-ins are registered
+
+// A directory under the build tree, emptied for each use.
+inline std::filesystem::path scratchDirectory(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("rp_core_test_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+inline void writeFile(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+}  // namespace rp::test
