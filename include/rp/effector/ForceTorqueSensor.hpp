@@ -1,0 +1,130 @@
+#pragma once
+/// @file
+/// The generic force/torque sensor interface (paper section 3.4).
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <string>
+
+#include "rp/core/PhysicalObject.hpp"
+#include "rp/io/IoStatus.hpp"
+#include "rp/math/Matrix.hpp"
+#include "rp/rt/TripleBuffer.hpp"
+
+namespace rp {
+
+/// One force/torque reading in the sensor frame.
+struct ForceTorqueReading {
+  Vector<3> force = Vector<3>::Zero();   ///< force [N]
+  Vector<3> torque = Vector<3>::Zero();  ///< torque [N m]
+  std::uint64_t count = 0;               ///< readings taken so far (0: none yet)
+};
+
+/// Generic interface of a force/torque sensor (paper section 3.4): read forces and torques,
+/// and bias (tare) the sensor.
+///
+/// Registers the interactive command `Bias`, describes a control panel with the last reading,
+/// and answers the message `read` with `{"force": [fx, fy, fz], "torque": [tx, ty, tz]}`.
+///
+/// In simulation mode the sensor reports the weight of a simulated payload (mass and centre of
+/// mass in the sensor frame; gravity is -z of the world, rotated by the sensor's pose) plus a
+/// simulated external wrench, minus the bias.
+///
+/// A servo loop calls update() once per cycle: it never blocks or allocates; when the sensor
+/// fails (closed, garbled, or no new reading for `maxMissedCycles` cycles in a row) it sets the
+/// error status and asks the ObjectManager for a system shutdown, so the arm is brought to rest.
+///
+/// rp.cfg settings (besides PhysicalObject's): `payload MASS` [kg],
+/// `payloadCenter X Y Z` [mm], `maxMissedCycles N` (default 50).
+class ForceTorqueSensor : public PhysicalObject {
+ public:
+  /// Creates the sensor and registers its command.
+  /// @param[in] name  object name (rp.cfg section); empty for an automatic name
+  /// @throws ConfigError if a setting is invalid
+  /// Real-time safe: no.
+  explicit ForceTorqueSensor(const std::string& name = "");
+  ~ForceTorqueSensor() override;
+
+  /// Declares `payload`, `payloadCenter` and `maxMissedCycles`.
+  /// @param[out] schema  schema to add to
+  static void declareSettings(SettingSchema& schema);
+
+  /// Takes a reading, waiting for the sensor if needed (bounded by the sensor's timeout).
+  /// @param[out] force  force in the sensor frame [N]
+  /// @param[out] torque  torque in the sensor frame [N m]
+  /// @return true on success; false on a sensor failure (see getErrorStatus())
+  /// Real-time safe: no. Do not call concurrently with update().
+  bool read(Vector<3>& force, Vector<3>& torque);
+  /// Takes the current load as zero (the sensor's own bias command on hardware).
+  /// @return true on success; false on a sensor failure
+  /// Real-time safe: no.
+  bool bias();
+  /// One servo cycle: fetches the newest reading without waiting; on a sensor failure sets the
+  /// error status and requests a system shutdown (once).
+  /// @return true if the sensor is healthy (a new reading, or a tolerated gap)
+  /// Real-time safe: yes.
+  bool update() noexcept;
+
+  /// The last reading (from read() or update()). Real-time safe: no (readers share a mutex).
+  ForceTorqueReading getLastReading() const;
+
+  /// Sets the simulated external wrench on the sensor.
+  /// @param[in] force  force in the sensor frame [N]
+  /// @param[in] torque  torque in the sensor frame [N m]
+  /// Real-time safe: no.
+  void setSimulatedWrench(const Vector<3>& force, const Vector<3>& torque);
+  /// Sets the simulated payload.
+  /// @param[in] mass  payload mass [kg], >= 0
+  /// @param[in] centerOfMass  centre of mass in the sensor frame [m]
+  /// Real-time safe: no.
+  void setSimulatedPayload(double mass, const Vector<3>& centerOfMass);
+
+  /// Adds the force and torque to the default panel. Real-time safe: no.
+  ControlPanel getControlPanel() const override;
+  /// Publishes force (3 values) and torque (3 values).
+  /// @param[out] snapshot  receives the values
+  /// @return true
+  /// Real-time safe: no.
+  bool getStateSnapshot(StateSnapshot& snapshot) const override;
+  /// Answers `read` with the last reading as JSON (taking a reading first if there is none).
+  /// Real-time safe: no.
+  bool handleMessage(const std::string& type, const std::string& payload, std::string& reply) override;
+
+ protected:
+  /// Fetches the newest hardware reading.
+  /// @param[out] force  [N]
+  /// @param[out] torque  [N m]
+  /// @param[in] timeoutMs  longest wait [ms]; 0 = do not wait (must then be real-time safe)
+  /// @return `kOk`, `kDataLoss` (a reading, with a gap before it), `kTimeout` (nothing new), or a
+  ///         failure; on failure `hardwareError()` says why
+  virtual IoStatus hardwareRead(Vector<3>& force, Vector<3>& torque, int timeoutMs) noexcept = 0;
+  /// Biases the hardware. @return `kOk` or a failure
+  virtual IoStatus hardwareBias() noexcept = 0;
+  /// The message of the last hardware failure.
+  virtual const char* hardwareError() const noexcept = 0;
+  /// The timeout read() gives hardwareRead() [ms].
+  virtual int readTimeoutMs() const noexcept { return 100; }
+
+ private:
+  void simulatedReading(Vector<3>& force, Vector<3>& torque) const;
+  void fail(const char* what) noexcept;
+  void publish(const Vector<3>& force, const Vector<3>& torque) noexcept;
+
+  mutable std::mutex simMutex_;
+  Vector<3> simForce_ = Vector<3>::Zero(), simTorque_ = Vector<3>::Zero();
+  double payloadMass_ = 0.0;
+  Vector<3> payloadCenter_ = Vector<3>::Zero();
+  Vector<3> biasForce_ = Vector<3>::Zero(), biasTorque_ = Vector<3>::Zero();  // simulation only
+  int maxMissedCycles_ = 50;
+  int missedCycles_ = 0;
+  std::atomic<bool> shutdownRequested_{false};
+  struct Published {  // trivially copyable form of a reading for the TripleBuffer
+    double values[6];
+    std::uint64_t count;
+  };
+  std::uint64_t count_ = 0;  // owned by the reading thread
+  TripleBuffer<Published> published_;
+};
+
+}  // namespace rp
