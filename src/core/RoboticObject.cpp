@@ -4,7 +4,6 @@
 #include <cxxabi.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
@@ -37,6 +36,7 @@ std::string demangleName(const char* mangled) {
 
 struct RoboticObject::Impl {
   std::string name;
+  bool automatic = false;
   std::uint64_t id = 0;
   std::shared_ptr<const Configuration> configuration;  // keeps `section` alive
   const ConfigSection* section = nullptr;
@@ -59,16 +59,19 @@ struct RoboticObject::Impl {
 
 RoboticObject::RoboticObject(const std::string& name) : impl_(std::make_unique<Impl>()) {
   auto& reg = internal::registry();
-  impl_->name = name;
+  impl_->automatic = name.empty();
   impl_->configuration = internal::currentConfiguration();
   if (!name.empty()) impl_->section = impl_->configuration->findSection(name);
   {
     std::lock_guard<std::recursive_mutex> lock(reg.mutex);
     if (!name.empty())
       for (RoboticObject* o : reg.objects)
-        if (!o->impl_->name.empty() && o->impl_->name == name)
+        if (o->impl_->name == name)
           throw std::invalid_argument("RoboticObject: an object named '" + name + "' already exists");
     impl_->id = reg.nextId.fetch_add(1);
+    // Automatic names do not depend on the class: other threads may list the object while it is
+    // still being constructed, when its dynamic class is not yet known.
+    impl_->name = name.empty() ? "object_" + std::to_string(impl_->id) : name;
     reg.objects.push_back(this);
   }
   internal::ensureShutdownWatcher();
@@ -82,16 +85,9 @@ RoboticObject::~RoboticObject() {
 
 void RoboticObject::declareSettings(SettingSchema&) {}
 
-std::string RoboticObject::getName() const {
-  if (!impl_->name.empty()) return impl_->name;
-  std::string cls = getClassName();
-  std::transform(cls.begin(), cls.end(), cls.begin(), [](unsigned char c) {
-    return std::isalnum(c) ? static_cast<char>(std::tolower(c)) : '_';
-  });
-  return cls + "_" + std::to_string(impl_->id);
-}
+std::string RoboticObject::getName() const { return impl_->name; }
 
-bool RoboticObject::hasAutomaticName() const noexcept { return impl_->name.empty(); }
+bool RoboticObject::hasAutomaticName() const noexcept { return impl_->automatic; }
 
 std::string RoboticObject::getClassName() const {
   if (const TypeInfo* info = TypeDatabase::instance().find(std::type_index(typeid(*this)))) return info->name;

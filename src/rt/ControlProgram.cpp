@@ -97,6 +97,7 @@ std::vector<ControlProgram*>& programs() {
 }
 
 std::atomic<bool> schedulingWarned{false};
+thread_local const void* currentLoop = nullptr;  // the program whose loop runs in this thread
 std::once_flag memoryLocked;
 
 }  // namespace
@@ -114,7 +115,6 @@ struct ControlProgram::Impl {
   // Lifecycle.
   std::mutex lifecycle;
   std::thread thread;
-  std::thread::id threadId;
   std::atomic<bool> running{false};
   std::atomic<bool> stopRequested{false};
   std::mutex endMutex;
@@ -284,6 +284,7 @@ struct ControlProgram::Impl {
   }
 
   void threadMain() {
+    internal::currentLoop = this;
     self.enterControl();
     if (auto* sim = dynamic_cast<SimulatedClock*>(clock)) {
       runSimulated(*sim);
@@ -393,7 +394,6 @@ void ControlProgram::start() {
   if (auto* sim = dynamic_cast<SimulatedClock*>(d.clock)) sim->attach(d.participant);
   d.running = true;
   d.thread = std::thread([&d] { d.threadMain(); });
-  d.threadId = d.thread.get_id();
 }
 
 void ControlProgram::requestStop() noexcept {
@@ -406,7 +406,7 @@ void ControlProgram::requestStop() noexcept {
 
 void ControlProgram::stop() {
   Impl& d = *impl_;
-  if (d.thread.joinable() && std::this_thread::get_id() == d.threadId) {
+  if (internal::currentLoop == &d) {  // called from the loop itself: only ask
     requestStop();
     return;
   }

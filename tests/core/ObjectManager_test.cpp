@@ -108,7 +108,7 @@ TEST_F(ObjectManagerTest, ObjectsRegisterAndLeave) {
     EXPECT_EQ(om.getDerivedObjects<PhysicalObject>().size(), 2u);
     EXPECT_EQ(om.getDerivedObjects<TestFunction>().size(), 1u);
     EXPECT_TRUE(a.hasAutomaticName());
-    EXPECT_EQ(a.getName().rfind("testarm_", 0), 0u) << a.getName();
+    EXPECT_EQ(a.getName().rfind("object_", 0), 0u) << a.getName();
     EXPECT_NE(a.getName(), TestArm().getName());
     EXPECT_EQ(om.findObject(a.getName()), &a);
     EXPECT_EQ(om.findObject("named"), &b);
@@ -227,8 +227,10 @@ TEST(ObjectManagerThreads, RegistrationFromManyThreads) {
   threads.emplace_back([&] {
     while (!go) std::this_thread::yield();
     for (int i = 0; i < 200; ++i) {
+      // Names are safe to read while other threads construct and destroy objects.
       std::set<std::string> names;
-      for (const auto& info : om.getObjectList()) EXPECT_TRUE(names.insert(info.name).second) << info.name;
+      om.forEachObject([&](RoboticObject& o) { EXPECT_TRUE(names.insert(o.getName()).second) << o.getName(); });
+      (void)om.findObject("t0_5");
     }
   });
   go = true;

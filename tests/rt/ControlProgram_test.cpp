@@ -347,11 +347,12 @@ class LoopObject : public PhysicalObject, public ControlProgram {
 
 TEST(ControlProgramThreads, ShutdownRequestedInsideALoopReachesEveryObject) {
   ObjectManager::resetShutdown();
-  SimulatedClock clock(1e-3);
+  SimulatedClock clock(1e-3, true);  // paused until every object exists
   LoopObject failing(clock, 50), other(clock, 1u << 30);
   PhysicalObject passive;
   EXPECT_TRUE(failing.needsControlLoop());
   EXPECT_EQ(failing.getProgramName(), failing.getName());
+  clock.resume();
   ASSERT_TRUE(ObjectManager::waitForShutdown(60));
   EXPECT_EQ(ObjectManager::getShutdownReason(), "torque limit exceeded on joint 3");
   EXPECT_EQ(failing.getErrorStatus().message, "torque limit exceeded");

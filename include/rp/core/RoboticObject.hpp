@@ -82,7 +82,12 @@ struct ObjectInfo {
 /// An object registers with the ObjectManager in its constructor and leaves it in its
 /// destructor, from any thread. An object created with a name is configured from the rp.cfg
 /// section of that name (each constructor level reads its own settings from configSection());
-/// an object created without a name gets a unique automatic name such as `puma560_3`.
+/// an object created without a name gets a unique automatic name such as `object_3`.
+///
+/// Threads: an object is in the ObjectManager's list from the start of its construction to the
+/// end of its destruction. Its name is safe to read from any thread at any time; its virtual
+/// functions only while it is complete (other threads should not use objects that may be in
+/// construction or destruction; derived classes stop their control loop first in their destructor).
 ///
 /// Classes that can be named in rp.cfg have a constructor taking `const std::string& name`
 /// and are registered with RP_REGISTER_CLASS (see TypeDatabase.hpp). The settings a class
@@ -106,7 +111,7 @@ class RoboticObject {
   /// @param[out] schema  schema to add to
   static void declareSettings(SettingSchema& schema);
 
-  /// Object name (the given one, or the automatic one).
+  /// Object name (the given one, or the automatic `object_N`). Safe from any thread.
   /// Real-time safe: no.
   std::string getName() const;
   /// Whether the name was generated automatically.
