@@ -1,0 +1,112 @@
+// rp-device: creates one object from rp.cfg and runs one of its interactive commands, or prints
+// its readings as JSON, then exits.
+//
+//   rp-device [-config FILE] [-sim|-nosim] NAME COMMAND|read
+//
+// Examples: rp-device gripper Close      rp-device -config cell.cfg ftsensor read
+// The object uses its hardware unless -sim is given or its rp.cfg section says simulationMode on.
+// Exit status: 0 done; 1 device error (the object's error status is printed); 2 configuration
+// or usage error (bad switch, bad rp.cfg, unknown object, unknown command).
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "rp/core/ObjectManager.hpp"
+#include "rp/core/RoboticPlatform.hpp"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: rp-device [-config FILE] [-sim|-nosim] NAME COMMAND|read\n"
+    "  runs the interactive command COMMAND of the rp.cfg object NAME (e.g. rp-device gripper Close),\n"
+    "  or prints its readings as JSON (rp-device ftsensor read)\n"
+    "  exit status: 0 done, 1 device error, 2 configuration or usage error\n";
+
+std::string commandList(const rp::RoboticObject& object) {
+  std::string out;
+  for (const auto& c : object.getCommands()) out += (out.empty() ? "" : ", ") + c.name;
+  return out.empty() ? "none" : out;
+}
+
+int deviceError(const rp::RoboticObject& object) {
+  std::cerr << "rp-device: " << object.getName() << ": " << object.getErrorStatus().message << std::endl;
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> positional;
+  bool simulate = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "-config") {
+      if (i + 1 >= argc) {
+        std::cerr << "rp-device: -config needs a file name\n" << kUsage;
+        return 2;
+      }
+      rp::RoboticPlatform::setConfigurationFileName(argv[++i]);
+    } else if (arg == "-sim") {
+      simulate = true;
+    } else if (arg == "-nosim") {
+      simulate = false;
+    } else if (arg == "-h" || arg == "-help" || arg == "--help") {
+      std::cout << kUsage;
+      return 0;
+    } else if (!arg.empty() && arg[0] == '-') {
+      std::cerr << "rp-device: unknown switch '" << arg << "'\n" << kUsage;
+      return 2;
+    } else {
+      positional.push_back(arg);
+    }
+  }
+  if (positional.size() != 2) {
+    std::cerr << "rp-device: expected NAME and COMMAND\n" << kUsage;
+    return 2;
+  }
+  const std::string& name = positional[0];
+  const std::string& command = positional[1];
+  if (simulate) rp::RoboticPlatform::setSimulationModeOn();
+  else rp::RoboticPlatform::setSimulationModeOff();
+
+  rp::ObjectManager om;
+  int status = 0;
+  try {
+    rp::RoboticPlatform::loadConfiguration();
+    rp::RoboticObject* object = om.createObject(name);
+    if (object->getErrorCode() != 0) {
+      status = deviceError(*object);
+    } else if (command == "read") {
+      std::string reply;
+      if (!object->handleMessage("read", "", reply)) {
+        std::cerr << "rp-device: " << name << " (" << object->getClassName() << ") has no readings\n";
+        status = 2;
+      } else if (object->getErrorCode() != 0) {
+        std::cout << reply << std::endl;
+        status = deviceError(*object);
+      } else {
+        std::cout << reply << std::endl;
+      }
+    } else {
+      bool known = false;
+      for (const auto& c : object->getCommands()) known = known || c.name == command;
+      if (!known) {
+        std::cerr << "rp-device: " << name << " (" << object->getClassName() << ") has no command '" << command
+                  << "' (commands: " << commandList(*object) << "; or read)\n";
+        status = 2;
+      } else {
+        object->executeCommand(command);
+        if (object->getErrorCode() != 0) status = deviceError(*object);
+        else std::cout << name << ": " << command << " done" << std::endl;
+      }
+    }
+  } catch (const rp::ConfigError& e) {
+    std::cerr << "rp-device: " << e.what() << std::endl;
+    status = 2;
+  } catch (const rp::ObjectError& e) {
+    std::cerr << "rp-device: " << e.what() << std::endl;
+    status = 2;
+  }
+  om.deleteAllObjects();
+  return status;
+}
