@@ -8,3 +8,5 @@
 #include "rp/math/Math.hpp"
 #include "rp/core/Core.hpp"
 #include "rp/rt/RealTime.hpp"
+#include "rp/io/Io.hpp"
+#include "rp/effector/Effector.hpp"
