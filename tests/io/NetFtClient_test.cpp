@@ -2,6 +2,7 @@
 #include "rp/io/NetFtClient.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -93,6 +94,7 @@ TEST_F(NetFtClientTest, StreamsTheEmulatedWrench) {
   EXPECT_EQ(client_->receivedRecords(), 10u);
   EXPECT_EQ(client_->lostRecords(), 0u);
   EXPECT_EQ(client_->outOfOrderRecords(), 0u);
+  for (int i = 0; i < 500 && sensor_.streaming(); ++i) ::usleep(1000);  // bounded
   EXPECT_FALSE(sensor_.streaming()) << "a finite stream ends by itself";
 }
 
