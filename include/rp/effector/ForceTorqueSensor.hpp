@@ -63,7 +63,9 @@ class ForceTorqueSensor : public PhysicalObject {
   /// One servo cycle: fetches the newest reading without waiting; on a sensor failure sets the
   /// error status and requests a system shutdown (once).
   /// @return true if the sensor is healthy (a new reading, or a tolerated gap)
-  /// Real-time safe: yes.
+  /// Real-time safe: yes on hardware (a non-blocking receive into fixed buffers, proven
+  /// allocation-free by the tests); in simulation it takes two short, uncontended locks to read
+  /// the pose and the simulated wrench.
   bool update() noexcept;
 
   /// The last reading (from read() or update()). Real-time safe: no (readers share a mutex).
