@@ -176,6 +176,14 @@ ControlPanel RoboticObject::getControlPanel() const {
   error.label = "Error code";
   error.kind = FieldKind::Number;
   panel.fields.push_back(error);
+  // The tunable parameters of the object's control loop, editable through setParameter().
+  if (ControlProgram* program = const_cast<RoboticObject*>(this)->getControlProgram()) {
+    for (const ParameterInfo& p : program->getParameters()) {
+      panel.fields.push_back(ControlPanelField{p.name, p.description.empty() ? p.name : p.description,
+                                               p.size > 1 ? FieldKind::Vector : FieldKind::Number,
+                                               static_cast<int>(p.size), p.unit, p.min, p.max, true, -1, {}});
+    }
+  }
   return panel;
 }
 

@@ -345,12 +345,48 @@ class LoopObject : public PhysicalObject, public ControlProgram {
   std::uint64_t failAt_;
 };
 
+class TunableObject : public FunctionalObject, public ControlProgram {
+ public:
+  TunableObject() : FunctionalObject("tunable") {
+    registerParameter("kp", kp_, 0, 500, "N m/rad", "proportional gain");
+    registerParameter("limit", limit_, 0, 10, "rad");
+  }
+  ControlProgram* getControlProgram() override { return this; }
+
+ protected:
+  void control() override {}
+
+ private:
+  Vector<6> kp_ = Vector<6>::Constant(10);
+  double limit_ = 1;
+};
+
+TEST(ControlProgram, ControlPanelListsTheTunableParameters) {
+  TunableObject o;
+  ControlPanel panel = o.getControlPanel();
+  EXPECT_EQ(panel.title, "tunable (TunableObject)");
+  ASSERT_EQ(panel.fields.size(), 3u);
+  EXPECT_EQ(panel.fields[0].name, "errorCode");
+  EXPECT_FALSE(panel.fields[0].tunable);
+  const ControlPanelField& kp = panel.fields[1];
+  EXPECT_EQ(kp.name, "kp");
+  EXPECT_EQ(kp.label, "proportional gain");
+  EXPECT_EQ(kp.kind, FieldKind::Vector);
+  EXPECT_EQ(kp.size, 6);
+  EXPECT_EQ(kp.unit, "N m/rad");
+  EXPECT_EQ(kp.max, 500.0);
+  EXPECT_TRUE(kp.tunable);
+  EXPECT_EQ(panel.fields[2].kind, FieldKind::Number);
+  EXPECT_EQ(panel.fields[2].label, "limit");
+}
+
 TEST(ControlProgramThreads, ShutdownRequestedInsideALoopReachesEveryObject) {
   ObjectManager::resetShutdown();
   SimulatedClock clock(1e-3, true);  // paused until every object exists
   LoopObject failing(clock, 50), other(clock, 1u << 30);
   PhysicalObject passive;
   EXPECT_TRUE(failing.needsControlLoop());
+  EXPECT_TRUE(failing.getInfo().hasControlLoop);
   EXPECT_EQ(failing.getProgramName(), failing.getName());
   clock.resume();
   ASSERT_TRUE(ObjectManager::waitForShutdown(60));

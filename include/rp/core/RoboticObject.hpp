@@ -177,7 +177,8 @@ class RoboticObject {
   /// @name GUI
   /// @{
 
-  /// The control panel description; the default has the object's name, class and error status.
+  /// The control panel description; the default has the object's name and class as title, its
+  /// error code, and one tunable field per parameter of its control program (if any).
   /// Real-time safe: no.
   virtual ControlPanel getControlPanel() const;
   /// Copies the latest state published by the object; false if it publishes none (default).
