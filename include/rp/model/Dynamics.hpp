@@ -1,0 +1,87 @@
+#pragma once
+/// @file
+/// Rigid-body dynamics over a model and a data object: inverse dynamics (recursive
+/// Newton-Euler), gravity, mass matrix, Coriolis/centrifugal torques and forward dynamics.
+
+#include "rp/model/ManipulatorData.hpp"
+
+namespace rp {
+
+/// Which effects the dynamics algorithms include.
+struct DynamicsOptions {
+  bool gravity = true;        ///< gravity of the model
+  bool motorInertia = false;  ///< reflected motor inertia \f$G^2 J_m \ddot q\f$
+  bool friction = false;      ///< viscous \f$B G^2 \dot q\f$ and Coulomb \f$|G| T_c\f$ friction (joint side)
+  /// A wrench (force [N], moment [N m]) that the end-effector's last link exerts on its
+  /// environment, in the last link frame; zero for none.
+  Vector<6> tipWrench;
+};
+
+/// Inverse dynamics by the recursive Newton-Euler algorithm:
+/// \f$\tau = M(q)\ddot q + C(q,\dot q)\dot q + g(q) [+ G^2 J_m \ddot q] [+ \tau_f(\dot q)]\f$.
+/// @param[in]  model    the manipulator
+/// @param[out] data     receives `tau`
+/// @param[in]  q        joint angles (n x 1) [rad]
+/// @param[in]  qd       joint velocities (n x 1) [rad/s]
+/// @param[in]  qdd      joint accelerations (n x 1) [rad/s^2]
+/// @param[in]  options  effects to include
+/// @return `data.tau` [N m]
+/// Real-time safe: yes.
+const JointVector& inverseDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
+                                   const JointVector& qd, const JointVector& qdd,
+                                   const DynamicsOptions& options = DynamicsOptions());
+
+/// The gravity torque \f$g(q)\f$ that holds the arm at rest in `q`.
+/// @param[in]  model  the manipulator
+/// @param[out] data   scratch
+/// @param[in]  q      joint angles (n x 1) [rad]
+/// @param[out] tau    gravity torques (n x 1) [N m]
+/// Real-time safe: yes.
+void gravityTorque(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q, JointVector& tau);
+
+/// The joint friction torque \f$\tau_f = B G^2 \dot q + |G| T_c(\mathrm{sign}\,\dot q)\f$ that the
+/// motors must overcome (zero Coulomb part at \f$\dot q = 0\f$).
+/// @param[in]  model  the manipulator
+/// @param[in]  qd     joint velocities (n x 1) [rad/s]
+/// @param[out] tau    friction torques (n x 1) [N m]
+/// Real-time safe: yes.
+void frictionTorque(const ManipulatorModel& model, const JointVector& qd, JointVector& tau);
+
+/// The Coriolis and centrifugal torques \f$C(q,\dot q)\dot q\f$.
+/// @param[in]  model  the manipulator
+/// @param[out] data   scratch
+/// @param[in]  q      joint angles (n x 1) [rad]
+/// @param[in]  qd     joint velocities (n x 1) [rad/s]
+/// @param[out] tau    torques (n x 1) [N m]
+/// Real-time safe: yes.
+void coriolisTorque(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q, const JointVector& qd,
+                    JointVector& tau);
+
+/// The joint-space mass matrix \f$M(q)\f$ (symmetric, positive definite), optionally with the
+/// reflected motor inertia on its diagonal. Computed column by column with the Newton-Euler
+/// algorithm.
+/// @param[in]  model         the manipulator
+/// @param[out] data          receives `massMatrix` (n x n) [kg m^2]
+/// @param[in]  q             joint angles (n x 1) [rad]
+/// @param[in]  motorInertia  add \f$G^2 J_m\f$ to the diagonal
+/// @return `data.massMatrix`
+/// Real-time safe: yes.
+const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
+                              bool motorInertia = false);
+
+/// Forward dynamics: the accelerations \f$\ddot q = M^{-1}(\tau - h(q, \dot q))\f$ that the
+/// torques `tau` produce, with \f$h\f$ the Newton-Euler torques at \f$\ddot q = 0\f$ and the
+/// effects in `options` (with motorInertia, \f$M\f$ includes \f$G^2 J_m\f$).
+/// @param[in]  model    the manipulator
+/// @param[out] data     receives `qdd` and `massMatrix`
+/// @param[in]  q        joint angles (n x 1) [rad]
+/// @param[in]  qd       joint velocities (n x 1) [rad/s]
+/// @param[in]  tau      applied joint torques (n x 1) [N m]
+/// @param[in]  options  effects to include
+/// @return `data.qdd` [rad/s^2]
+/// Real-time safe: yes.
+const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
+                                   const JointVector& qd, const JointVector& tau,
+                                   const DynamicsOptions& options = DynamicsOptions());
+
+}  // namespace rp

@@ -1,0 +1,46 @@
+#pragma once
+/// @file
+/// Results and scratch space of the kinematics and dynamics algorithms for one thread.
+
+#include <array>
+
+#include <Eigen/Cholesky>
+
+#include "rp/model/ManipulatorModel.hpp"
+
+namespace rp {
+
+/// Everything the algorithms compute for a ManipulatorModel, and their scratch space.
+///
+/// Made from a model, which fixes every size; each thread (servo, planner, viewer) has its own.
+/// No algorithm allocates: all storage is inside this object.
+struct ManipulatorData {
+  /// Creates data sized for `model` (n = number of joints).
+  /// @param[in] model  the model the data belongs to
+  explicit ManipulatorData(const ManipulatorModel& model);
+
+  int n;  ///< number of joints
+
+  /// Pose of link frame i (i = 0..n-1, the frame at the distal end of link i+1) in the world,
+  /// from the last forwardKinematics() [m].
+  std::array<Transform, kMaxJoints> linkTransforms;
+  /// Pose of the end-effector (tool) in the world, from the last forwardKinematics() [m].
+  Transform endEffector;
+
+  Jacobian jacobian;       ///< (6 x n) from the last jacobian call
+  JointVector tau;         ///< (n x 1) result of inverseDynamics() [N m]
+  JointVector qdd;         ///< (n x 1) result of forwardDynamics() [rad/s^2]
+  JointMatrix massMatrix;  ///< (n x n) from the last massMatrix() or forwardDynamics() [kg m^2]
+
+  /// @cond INTERNAL
+  // Scratch of the recursive Newton-Euler algorithm, per link, in link coordinates.
+  std::array<Matrix<3, 3>, kMaxJoints> R;       // rotation of A_i
+  std::array<Vector<3>, kMaxJoints> pstar;      // origin of frame i from frame i-1, in frame i
+  std::array<Vector<3>, kMaxJoints> w, wd, vd;  // angular velocity, acceleration, linear acceleration
+  std::array<Vector<3>, kMaxJoints> F, N;       // inertial force and moment at the centre of mass
+  JointVector scratchTau, zero, unitColumn;
+  Eigen::LDLT<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJoints, kMaxJoints>> ldlt;
+  /// @endcond
+};
+
+}  // namespace rp

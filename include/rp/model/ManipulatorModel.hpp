@@ -1,0 +1,139 @@
+#pragma once
+/// @file
+/// The constant description of a serial manipulator: kinematics (Denavit-Hartenberg), dynamics,
+/// drive train and limits (paper section 3.3, Figure 7).
+
+#include <string>
+#include <vector>
+
+#include "rp/math/Matrix.hpp"
+#include "rp/math/Transform.hpp"
+
+namespace rp {
+
+/// Largest number of joints a manipulator model may have.
+inline constexpr int kMaxJoints = 16;
+/// A vector with one value per joint (size set at run time, storage inside: never allocates).
+using JointVector = BoundedVector<kMaxJoints>;
+/// A joint-space matrix such as the mass matrix (never allocates).
+using JointMatrix = BoundedMatrix<kMaxJoints, kMaxJoints>;
+/// A geometric Jacobian: 6 rows (vx, vy, vz, wx, wy, wz), one column per joint (never allocates).
+using Jacobian = Matrix<6, Dynamic, double, 6, kMaxJoints>;
+
+/// Which Denavit-Hartenberg convention the link parameters follow.
+enum class DHConvention {
+  /// Standard (distal) DH: \f$A_i = R_z(\theta_i) T_z(d_i) T_x(a_i) R_x(\alpha_i)\f$; link frame
+  /// \f$i\f$ sits at the distal end of link \f$i\f$ and joint \f$i\f$ turns about \f$z_{i-1}\f$.
+  Standard,
+};
+
+/// Constant parameters of one link and its joint (all SI units, radians).
+///
+/// Friction and motor inertia follow the Robotics Toolbox's convention: they are given on the
+/// motor side and reflected to the joint through the gear ratio \f$G\f$: armature inertia
+/// \f$G^2 J_m\f$, viscous friction \f$B G^2 \dot q\f$ and Coulomb friction \f$|G| T_c\f$.
+struct LinkParameters {
+  double a = 0;       ///< DH link length [m]
+  double alpha = 0;   ///< DH link twist [rad]
+  double d = 0;       ///< DH link offset [m]
+  double offset = 0;  ///< joint angle offset: \f$\theta_i = q_i + \mathrm{offset}\f$ [rad]
+
+  double mass = 0;                          ///< link mass [kg]
+  Vector<3> com;                            ///< centre of mass in link frame \f$i\f$ [m]
+  Matrix<3, 3> inertia;                     ///< inertia tensor about the centre of mass, in frame \f$i\f$ [kg m^2]
+  double motorInertia = 0;                  ///< motor (armature) inertia \f$J_m\f$, motor side [kg m^2]
+  double gearRatio = 1;                     ///< gear ratio \f$G\f$ (motor turns per joint turn; sign allowed)
+  double viscousFriction = 0;               ///< viscous friction \f$B\f$, motor side [N m s/rad]
+  double coulombFrictionPositive = 0;       ///< Coulomb friction for \f$\dot q > 0\f$, motor side [N m] (>= 0)
+  double coulombFrictionNegative = 0;       ///< Coulomb friction for \f$\dot q < 0\f$, motor side [N m] (<= 0)
+
+  double positionMin = -3.14159265358979;   ///< lower joint limit [rad]
+  double positionMax = 3.14159265358979;    ///< upper joint limit [rad]
+  double velocityLimit = 3.0;               ///< largest joint speed [rad/s]
+  double accelerationLimit = 10.0;          ///< largest joint acceleration for trajectories [rad/s^2]
+  double jerkLimit = 100.0;                 ///< largest joint jerk for trajectories [rad/s^3]
+  double torqueLimit = 100.0;               ///< largest joint torque [N m]
+};
+
+/// The constant model of a serial manipulator with revolute joints: Denavit-Hartenberg
+/// kinematics, rigid-body dynamics, motor inertia, friction and limits, a base transform (the
+/// robot's pose in the world) and a tool transform (end-effector relative to the last link frame).
+///
+/// A model never changes after construction; algorithms (forwardKinematics(), inverseDynamics(),
+/// ...) read it and write into a ManipulatorData made from it, one per thread (the model/data split
+/// of Pinocchio and MuJoCo). Built-in robots derive from it: Puma560Model, WAM7Model, WAM4Model.
+class ManipulatorModel {
+ public:
+  /// Creates a model.
+  /// @param[in] name        robot name, e.g. `puma560`
+  /// @param[in] links       one entry per joint, from the base outwards (1 to kMaxJoints)
+  /// @param[in] base        pose of the base frame in the world [m]
+  /// @param[in] tool        pose of the end-effector in the last link frame [m]
+  /// @param[in] gravity     gravity acceleration in the world frame [m/s^2]
+  /// @param[in] convention  DH convention of `links`
+  /// @throws std::invalid_argument for 0 or more than kMaxJoints links, a negative mass, or
+  ///         limits with min > max
+  ManipulatorModel(std::string name, std::vector<LinkParameters> links, const Transform& base = Transform::unit(),
+                   const Transform& tool = Transform::unit(), const Vector<3>& gravity = standardGravity(),
+                   DHConvention convention = DHConvention::Standard);
+  virtual ~ManipulatorModel() = default;
+  ManipulatorModel(const ManipulatorModel&) = default;             ///< copyable
+  ManipulatorModel& operator=(const ManipulatorModel&) = delete;  ///< a model never changes
+
+  /// Gravity of 9.81 m/s^2 along -z.
+  static Vector<3> standardGravity() {
+    Vector<3> g;
+    g(2) = -9.81;
+    return g;
+  }
+
+  /// Robot name. Real-time safe: yes.
+  const std::string& getName() const { return name_; }
+  /// Number of joints. Real-time safe: yes.
+  int getNumberOfJoints() const { return static_cast<int>(links_.size()); }
+  /// Parameters of joint/link `i` (from 0). Real-time safe: yes.
+  const LinkParameters& getLink(int i) const { return links_[static_cast<std::size_t>(i)]; }
+  /// DH convention. Real-time safe: yes.
+  DHConvention getConvention() const { return convention_; }
+  /// Pose of the base in the world [m]. Real-time safe: yes.
+  const Transform& getBaseTransform() const { return base_; }
+  /// Pose of the end-effector in the last link frame [m]. Real-time safe: yes.
+  const Transform& getToolTransform() const { return tool_; }
+  /// Gravity in the world frame [m/s^2]. Real-time safe: yes.
+  const Vector<3>& getGravity() const { return gravity_; }
+
+  /// Lower joint limits [rad] (numberOfJoints x 1). Real-time safe: yes.
+  const JointVector& getPositionMin() const { return qmin_; }
+  /// Upper joint limits [rad]. Real-time safe: yes.
+  const JointVector& getPositionMax() const { return qmax_; }
+  /// Joint speed limits [rad/s]. Real-time safe: yes.
+  const JointVector& getVelocityLimit() const { return vmax_; }
+  /// Joint acceleration limits for trajectories [rad/s^2]. Real-time safe: yes.
+  const JointVector& getAccelerationLimit() const { return amax_; }
+  /// Joint jerk limits for trajectories [rad/s^3]. Real-time safe: yes.
+  const JointVector& getJerkLimit() const { return jmax_; }
+  /// Joint torque limits [N m]. Real-time safe: yes.
+  const JointVector& getTorqueLimit() const { return taumax_; }
+  /// Reflected motor inertia \f$G^2 J_m\f$ per joint [kg m^2]. Real-time safe: yes.
+  const JointVector& getArmatureInertia() const { return armature_; }
+  /// Whether `q` lies within the joint limits (inclusive). Real-time safe: yes.
+  bool isWithinLimits(const JointVector& q) const;
+
+  /// A good resting configuration (the model's home or ready pose) [rad]. Real-time safe: yes.
+  const JointVector& getHomePosition() const { return home_; }
+
+ protected:
+  /// Sets the home configuration (derived models call it in their constructor).
+  /// @param[in] q  home joint angles [rad]
+  void setHomePosition(const JointVector& q);
+
+ private:
+  std::string name_;
+  std::vector<LinkParameters> links_;
+  Transform base_, tool_;
+  Vector<3> gravity_;
+  DHConvention convention_;
+  JointVector qmin_, qmax_, vmax_, amax_, jmax_, taumax_, armature_, home_;
+};
+
+}  // namespace rp

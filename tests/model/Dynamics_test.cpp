@@ -1,0 +1,127 @@
+// Internal consistency of the dynamics on seeded random states of every built-in robot:
+// RNEA = M qdd + C + g, forward dynamics inverts inverse dynamics, the Jacobian matches finite
+// differences of forward kinematics, and J^T F matches the Newton-Euler tip wrench.
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+
+#include "rp/model/Dynamics.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/model/Puma560Model.hpp"
+#include "rp/model/WAMModel.hpp"
+
+namespace rp {
+namespace {
+
+std::vector<std::unique_ptr<ManipulatorModel>> robots() {
+  std::vector<std::unique_ptr<ManipulatorModel>> r;
+  r.push_back(std::make_unique<Puma560Model>());
+  r.push_back(std::make_unique<WAM7Model>());
+  r.push_back(std::make_unique<WAM4Model>());
+  return r;
+}
+
+JointVector randomJoints(const ManipulatorModel& m, std::mt19937_64& rng, double scale = 1.0) {
+  JointVector q(m.getNumberOfJoints());
+  for (int i = 0; i < m.getNumberOfJoints(); ++i) {
+    std::uniform_real_distribution<double> d(m.getPositionMin()(i) * scale, m.getPositionMax()(i) * scale);
+    q(i) = d(rng);
+  }
+  return q;
+}
+
+TEST(Dynamics, NewtonEulerEqualsMassMatrixPlusBiasTerms) {
+  std::mt19937_64 rng(1);
+  for (auto& robot : robots()) {
+    ManipulatorData data(*robot);
+    const int n = robot->getNumberOfJoints();
+    for (int trial = 0; trial < 200; ++trial) {
+      const JointVector q = randomJoints(*robot, rng), qd = randomJoints(*robot, rng), qdd = randomJoints(*robot, rng);
+      DynamicsOptions opt;
+      opt.motorInertia = true;
+      const JointVector tau = inverseDynamics(*robot, data, q, qd, qdd, opt);
+      const JointMatrix M = massMatrix(*robot, data, q, true);
+      JointVector c(n), g(n);
+      coriolisTorque(*robot, data, q, qd, c);
+      gravityTorque(*robot, data, q, g);
+      const JointVector sum = M * qdd + c + g;
+      for (int i = 0; i < n; ++i) EXPECT_NEAR(tau(i), sum(i), 1e-10 * (1 + std::abs(tau(i)))) << robot->getName();
+      // M is symmetric positive definite.
+      EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Eigen::MatrixXd(M)).eigenvalues().minCoeff(), 0.0);
+    }
+  }
+}
+
+TEST(Dynamics, ForwardDynamicsInvertsInverseDynamics) {
+  std::mt19937_64 rng(2);
+  for (auto& robot : robots()) {
+    ManipulatorData data(*robot);
+    for (int trial = 0; trial < 200; ++trial) {
+      const JointVector q = randomJoints(*robot, rng), qd = randomJoints(*robot, rng), qdd = randomJoints(*robot, rng);
+      DynamicsOptions opt;
+      opt.motorInertia = trial % 2 == 0;
+      opt.friction = trial % 3 == 0;
+      const JointVector tau = inverseDynamics(*robot, data, q, qd, qdd, opt);
+      const JointVector back = forwardDynamics(*robot, data, q, qd, tau, opt);
+      for (int i = 0; i < robot->getNumberOfJoints(); ++i) EXPECT_NEAR(back(i), qdd(i), 1e-8) << robot->getName();
+    }
+  }
+}
+
+TEST(Dynamics, JacobianMatchesFiniteDifferencesOfForwardKinematics) {
+  std::mt19937_64 rng(3);
+  const double h = 1e-6;
+  for (auto& robot : robots()) {
+    ManipulatorData data(*robot), fd(*robot);
+    for (int trial = 0; trial < 100; ++trial) {
+      const JointVector q = randomJoints(*robot, rng);
+      const Jacobian J = jacobian(*robot, data, q);
+      const Transform T0 = forwardKinematics(*robot, fd, q);
+      for (int j = 0; j < robot->getNumberOfJoints(); ++j) {
+        JointVector qp = q, qm = q;
+        qp(j) += h;
+        qm(j) -= h;
+        const Transform Tp = forwardKinematics(*robot, fd, qp);
+        const Transform Tm = forwardKinematics(*robot, fd, qm);
+        const Eigen::Vector3d v = (Tp.topRightCorner<3, 1>() - Tm.topRightCorner<3, 1>()) / (2 * h);
+        // Angular velocity from dR/dq R^T (a skew matrix).
+        const Eigen::Matrix3d S = (Tp.topLeftCorner<3, 3>() - Tm.topLeftCorner<3, 3>()) / (2 * h) *
+                                  T0.topLeftCorner<3, 3>().transpose();
+        const Eigen::Vector3d w(S(2, 1), S(0, 2), S(1, 0));
+        for (int r = 0; r < 3; ++r) {
+          EXPECT_NEAR(J(r, j), v(r), 1e-7) << robot->getName();
+          EXPECT_NEAR(J(r + 3, j), w(r), 1e-7) << robot->getName();
+        }
+      }
+    }
+  }
+}
+
+TEST(Dynamics, TransposedJacobianMatchesNewtonEulerTipWrench) {
+  // A wrench exerted by the last link on its environment costs J^T F in joint torque: compare
+  // with the Newton-Euler algorithm's own tip-wrench path (gravity and motion off).
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-5, 5);
+  for (auto& robot : robots()) {
+    if (!robot->getToolTransform().isIdentity(0.0)) continue;  // the tip wrench acts at link frame n
+    ManipulatorData data(*robot);
+    const int n = robot->getNumberOfJoints();
+    for (int trial = 0; trial < 100; ++trial) {
+      const JointVector q = randomJoints(*robot, rng), z = JointVector(n);
+      Vector<6> w;
+      for (int i = 0; i < 6; ++i) w(i) = u(rng);
+      DynamicsOptions opt;
+      opt.gravity = false;
+      opt.tipWrench = w;
+      const JointVector tau = inverseDynamics(*robot, data, q, z, z, opt);
+      JointVector viaJ(n);
+      endEffectorForceToJointTorque(*robot, data, q, w, viaJ, ReferenceFrame::EndEffector);
+      for (int i = 0; i < n; ++i) EXPECT_NEAR(tau(i), viaJ(i), 1e-10) << robot->getName();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rp
