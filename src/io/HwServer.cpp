@@ -95,9 +95,9 @@ void HwServer::start() {
   shm_->rateHz = rateHz_;
   shm_->serverPid.store(static_cast<std::int32_t>(::getpid()));
   cycle(true);  // inputs valid and outputs at zero before the first client looks
-  std::atomic_thread_fence(std::memory_order_release);
   shm_->magic = internal::kHwServerMagic;
-  shm_->state.store(static_cast<std::int32_t>(internal::HwServerState::kRunning));
+  // Publishes everything above: clients read `state` (acquire) before any other field.
+  shm_->state.store(static_cast<std::int32_t>(internal::HwServerState::kRunning), std::memory_order_release);
   stopRequested_.store(false);
   thread_ = std::thread([this] { run(); });
 }

@@ -33,8 +33,8 @@ HwServerIoBoard::HwServerIoBoard(const std::string& name, int staleTimeoutMs)
   if (p == MAP_FAILED)
     throw IoException("HwServerIoBoard: cannot map " + shmName + ": " + std::strerror(errno));
   shm_ = static_cast<internal::HwServerShm*>(p);
-  std::atomic_thread_fence(std::memory_order_acquire);
-  if (shm_->magic != internal::kHwServerMagic || shm_->version != internal::kHwServerVersion ||
+  const auto state = shm_->state.load(std::memory_order_acquire);  // pairs with the server's release
+  if (state == static_cast<std::int32_t>(internal::HwServerState::kStarting) || shm_->magic != internal::kHwServerMagic || shm_->version != internal::kHwServerVersion ||
       shm_->size != sizeof(internal::HwServerShm)) {
     ::munmap(shm_, sizeof(internal::HwServerShm));
     shm_ = nullptr;
@@ -68,8 +68,7 @@ IoStatus HwServerIoBoard::checkServer() noexcept {
     for (int attempt = 0; attempt < 8; ++attempt) {  // sequence lock, bounded retries
       const std::uint32_t before = shm_->messageSeq.load(std::memory_order_acquire);
       std::memcpy(message, shm_->message, sizeof message);
-      std::atomic_thread_fence(std::memory_order_acquire);
-      if ((before & 1u) == 0 && shm_->messageSeq.load(std::memory_order_relaxed) == before) break;
+      if ((before & 1u) == 0 && shm_->messageSeq.load(std::memory_order_acquire) == before) break;
     }
     message[sizeof message - 1] = '\0';
     return error_.set(IoStatus::kDeviceError, "hardware server '%s': board error (%s): %s", name_.c_str(),
