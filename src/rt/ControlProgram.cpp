@@ -381,17 +381,28 @@ void ControlProgram::start() {
         d.logSources.push_back(v.data + i);
       }
     }
-    if (!columns.empty()) {
-      d.channel = std::make_shared<LogWriter::Channel>(d.name, std::move(columns), d.logBufferSize);
-      writer->addChannel(d.channel);
-    }
+    if (!columns.empty()) d.channel = std::make_shared<LogWriter::Channel>(d.name, std::move(columns), d.logBufferSize);
   }
   d.writer = writer;
   {
     std::lock_guard<std::mutex> elock(d.endMutex);
     d.ended = false;
   }
-  if (auto* sim = dynamic_cast<SimulatedClock*>(d.clock)) sim->attach(d.participant);
+  // Once attached, the simulated clock cannot pass this program's first tick, so the time of the
+  // first sample is known now: the writer holds back rows from that time on until it arrives.
+  double firstTime;
+  if (auto* sim = dynamic_cast<SimulatedClock*>(d.clock)) {
+    sim->attach(d.participant);
+    const auto m = static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / d.rate / sim->getStep())));
+    firstTime = sim->tickTime((sim->getTick() + m - 1) / m * m);
+  } else {
+    firstTime = RealClock::instance().getTime();
+  }
+  if (d.channel) {
+    d.channel->lastTime = std::nextafter(firstTime, -std::numeric_limits<double>::infinity());
+    d.channel->any = true;
+    writer->addChannel(d.channel);
+  }
   d.running = true;
   d.thread = std::thread([&d] { d.threadMain(); });
 }

@@ -115,9 +115,9 @@ TEST(ClientServerThreads, TimeoutsFullQueueHandlerErrorsAndCleanStop) {
     return x + 1;
   });
   Client<int, int> client(server);
-  std::future<int> first = client.send(1);  // taken by the server, blocked in the handler
+  PendingReply<int> first = client.send(1);  // taken by the server, blocked in the handler
   while (server.getQueueLength() != 0) std::this_thread::yield();
-  std::future<int> queued = client.send(2);  // fills the queue (capacity 1)
+  PendingReply<int> queued = client.send(2);  // fills the queue (capacity 1)
   try {
     client.call(3, 20ms);  // no room
     FAIL();
@@ -125,9 +125,11 @@ TEST(ClientServerThreads, TimeoutsFullQueueHandlerErrorsAndCleanStop) {
     EXPECT_EQ(e.kind(), CommunicationError::Kind::Timeout);
     EXPECT_STREQ(e.what(), "Client: the server's queue stayed full");
   }
+  EXPECT_FALSE(first.isReady());
   gate.unlock();
-  EXPECT_EQ(first.get(), 2);
-  EXPECT_EQ(queued.get(), 3);
+  EXPECT_EQ(first.get(10s), 2);
+  EXPECT_EQ(queued.get(10s), 3);
+  EXPECT_TRUE(first.isReady());
   try {
     client.call(-1);
     FAIL();
@@ -144,7 +146,7 @@ TEST(ClientServerThreads, TimeoutsFullQueueHandlerErrorsAndCleanStop) {
     EXPECT_EQ(e.kind(), CommunicationError::Kind::Timeout);
     EXPECT_STREQ(e.what(), "Client: no reply within the timeout");
   }
-  std::future<int> dropped = client.send(6);
+  PendingReply<int> dropped = client.send(6);
   std::thread stopper([&] { server.stop(); });
   std::this_thread::sleep_for(10ms);
   gate.unlock();  // let the request being served finish; the queued one is failed

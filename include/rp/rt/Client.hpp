@@ -3,7 +3,6 @@
 /// Client: sends typed requests to a Server and waits for the replies (paper section 3.7).
 
 #include <chrono>
-#include <future>
 
 #include "rp/rt/Server.hpp"
 
@@ -27,17 +26,14 @@ class Client {
   /// Real-time safe: no.
   Reply call(Request request, std::chrono::milliseconds timeout = std::chrono::milliseconds(1000)) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
-    std::future<Reply> reply = server_.post(std::move(request), deadline);
-    if (reply.wait_until(deadline) != std::future_status::ready)
-      throw CommunicationError(CommunicationError::Kind::Timeout, "Client: no reply within the timeout");
-    return reply.get();
+    return server_.post(std::move(request), deadline).get(deadline);
   }
   /// Sends a request without waiting for the reply.
   /// @param[in] request  the request
   /// @param[in] timeout  longest wait for room in the queue
-  /// @return the future reply
+  /// @return the reply to come (PendingReply::get() waits for it)
   /// @throws CommunicationError (Timeout, ServerStopped)
-  std::future<Reply> send(Request request, std::chrono::milliseconds timeout = std::chrono::milliseconds(1000)) {
+  PendingReply<Reply> send(Request request, std::chrono::milliseconds timeout = std::chrono::milliseconds(1000)) {
     return server_.post(std::move(request), std::chrono::steady_clock::now() + timeout);
   }
 

@@ -7,7 +7,8 @@
 #include <cstddef>
 #include <deque>
 #include <functional>
-#include <future>
+#include <optional>
+#include <string>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -33,6 +34,68 @@ class CommunicationError : public std::runtime_error {
 
  private:
   Kind kind_;
+};
+
+/// The reply to a request sent with Client::send(), available later.
+/// @tparam Reply  reply type
+template <typename Reply>
+class PendingReply {
+ public:
+  /// @cond INTERNAL
+  struct Slot {
+    std::mutex mutex;
+    std::condition_variable cv;
+    bool ready = false;
+    std::optional<Reply> value;
+    CommunicationError::Kind kind = CommunicationError::Kind::ServerStopped;
+    std::string error;
+    void setValue(Reply v) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        value.emplace(std::move(v));
+        ready = true;
+      }
+      cv.notify_all();
+    }
+    void setError(CommunicationError::Kind k, std::string message) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        kind = k;
+        error = std::move(message);
+        ready = true;
+      }
+      cv.notify_all();
+    }
+  };
+  explicit PendingReply(std::shared_ptr<Slot> slot) : slot_(std::move(slot)) {}
+  /// @endcond
+
+  /// Whether the reply (or an error) has arrived.
+  bool isReady() const {
+    std::lock_guard<std::mutex> lock(slot_->mutex);
+    return slot_->ready;
+  }
+  /// Waits for the reply until `deadline`.
+  /// @param[in] deadline  latest time to wait until
+  /// @return the reply
+  /// @throws CommunicationError (Timeout, ServerStopped, HandlerFailed)
+  Reply get(std::chrono::steady_clock::time_point deadline) {
+    std::unique_lock<std::mutex> lock(slot_->mutex);
+    if (!slot_->cv.wait_until(lock, deadline, [&] { return slot_->ready; }))
+      throw CommunicationError(CommunicationError::Kind::Timeout, "Client: no reply within the timeout");
+    if (!slot_->value) throw CommunicationError(slot_->kind, slot_->error);  // a fresh copy for this thread
+    return *slot_->value;
+  }
+  /// Waits for the reply at most `timeout`.
+  /// @param[in] timeout  longest wait
+  /// @return the reply
+  /// @throws CommunicationError (Timeout, ServerStopped, HandlerFailed)
+  Reply get(std::chrono::milliseconds timeout = std::chrono::milliseconds(1000)) {
+    return get(std::chrono::steady_clock::now() + timeout);
+  }
+
+ private:
+  std::shared_ptr<Slot> slot_;
 };
 
 /// Serves requests of type `Request` with replies of type `Reply` in its own thread, one at a
@@ -77,8 +140,7 @@ class Server {
     cv_.notify_all();
     if (thread_.joinable()) thread_.join();
     for (auto& p : dropped)
-      p->reply.set_exception(std::make_exception_ptr(
-          CommunicationError(CommunicationError::Kind::ServerStopped, "Server: stopped before serving the request")));
+      p->slot->setError(CommunicationError::Kind::ServerStopped, "Server: stopped before serving the request");
     std::lock_guard<std::mutex> lock(mutex_);
     running_ = false;
   }
@@ -96,12 +158,12 @@ class Server {
   /// @cond INTERNAL
   struct Pending {
     Request request;
-    std::promise<Reply> reply;
+    std::shared_ptr<typename PendingReply<Reply>::Slot> slot;
   };
-  // Queues a request, waiting up to `timeout` for room. Used by Client.
-  std::future<Reply> post(Request request, std::chrono::steady_clock::time_point deadline) {
-    auto pending = std::make_shared<Pending>(Pending{std::move(request), {}});
-    std::future<Reply> future = pending->reply.get_future();
+  // Queues a request, waiting until `deadline` for room. Used by Client.
+  PendingReply<Reply> post(Request request, std::chrono::steady_clock::time_point deadline) {
+    auto slot = std::make_shared<typename PendingReply<Reply>::Slot>();
+    auto pending = std::make_shared<Pending>(Pending{std::move(request), slot});
     std::unique_lock<std::mutex> lock(mutex_);
     if (!running_ || stopping_)
       throw CommunicationError(CommunicationError::Kind::ServerStopped, "Client: the server is not running");
@@ -111,7 +173,7 @@ class Server {
     queue_.push_back(std::move(pending));
     lock.unlock();
     cv_.notify_one();
-    return future;
+    return PendingReply<Reply>(slot);
   }
   /// @endcond
 
@@ -130,14 +192,13 @@ class Server {
         queue_.pop_front();
       }
       space_.notify_one();
+      // Errors cross threads as plain strings (never as a shared exception object).
       try {
-        p->reply.set_value(handler_(p->request));
+        p->slot->setValue(handler_(p->request));
       } catch (const std::exception& e) {
-        p->reply.set_exception(
-            std::make_exception_ptr(CommunicationError(CommunicationError::Kind::HandlerFailed, e.what())));
+        p->slot->setError(CommunicationError::Kind::HandlerFailed, e.what());
       } catch (...) {
-        p->reply.set_exception(std::make_exception_ptr(
-            CommunicationError(CommunicationError::Kind::HandlerFailed, "Server: the handler threw")));
+        p->slot->setError(CommunicationError::Kind::HandlerFailed, "Server: the handler threw");
       }
     }
   }
