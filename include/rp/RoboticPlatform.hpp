@@ -8,5 +8,7 @@
 #include "rp/math/Math.hpp"
 #include "rp/core/Core.hpp"
 #include "rp/rt/RealTime.hpp"
+#include "rp/model/Model.hpp"
+#include "rp/manipulator/Manipulators.hpp"
 #include "rp/io/Io.hpp"
 #include "rp/effector/Effector.hpp"

@@ -1,0 +1,148 @@
+#pragma once
+/// @file
+/// The default implementation of open-architecture manipulators: the servo loop (paper section
+/// 3.3, Figure 11) and simulation mode.
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <thread>
+
+#include "rp/control/DefaultPositionControl.hpp"
+#include "rp/manipulator/Manipulator.hpp"
+#include "rp/manipulator/ManipulatorSimulation.hpp"
+#include "rp/rt/ControlProgram.hpp"
+#include "rp/rt/TripleBuffer.hpp"
+#include "rp/trajectory/Setpoint.hpp"
+
+namespace rp {
+
+/// A manipulator whose servo loop runs in its own ControlProgram thread, spawned when the object
+/// is created (paper Figure 11). Every cycle:
+/// 1. read the joints (from the arm, or from the dynamic simulation in simulation mode);
+/// 2. get the setpoint from the trajectory generator (hold the current position when there is
+///    none);
+/// 3. run the servo control (a DefaultPositionControl unless switched), plus the gravity torque
+///    when gravity compensation is on (only the gravity torque in zero-gravity mode);
+/// 4. check the limits: a joint outside its position limits, faster than its velocity limit, or a
+///    commanded torque above its torque limit sets the error status (naming the joint, the value
+///    and the limit) and requests a system shutdown;
+/// 5. output the torques (to the amplifiers, or integrate the model's forward dynamics);
+/// 6. publish the state for other threads and sample the log variables `q`, `qd`, `qdes`, `tau`.
+///
+/// Shutdown (system shutdown or after a violation): a damped hold (velocity damping plus gravity
+/// compensation) until the arm is at rest, then power off (brakes on).
+///
+/// The arm power is on when the loop starts, holding the position the arm is in. In simulation
+/// mode the arm starts at rest at the model's home position.
+class DefaultManipulator : public Manipulator, public ControlProgram {
+ public:
+  /// Makes the model once the object's pose (rp.cfg `position`/`orientation`) is known.
+  using ModelFactory = std::function<std::unique_ptr<ManipulatorModel>(const Transform& base)>;
+
+  /// Creates the manipulator. Derived classes call startControlLoop() at the end of their
+  /// constructor.
+  /// @param[in] name          object name; empty for an automatic name
+  /// @param[in] modelFactory  makes the model for the given base pose
+  /// @throws std::runtime_error if simulation mode is off and no hardware is configured
+  DefaultManipulator(const std::string& name, const ModelFactory& modelFactory);
+  /// Stops the servo loop.
+  ~DefaultManipulator() override;
+
+  const ManipulatorModel& getModel() const override { return *model_; }
+  double getServoPeriod() const override { return getPeriod(); }
+  ControlProgram* getControlProgram() override { return this; }
+
+  JointVector getJointPosition() const override;
+  JointVector getJointVelocity() const override;
+  const Setpoint& getSetpoint() const override;
+  JointVector getControlOutput() const override;
+  void setControlOutput(const Eigen::Ref<const Eigen::VectorXd>& torque) override;
+
+  void enableArmPower() override;
+  void disableArmPower() override;
+  bool isArmPowerOn() const override;
+
+  Transform getEndEffectorTransform() const override;
+  void endEffectorForceToJointTorque(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                     const Eigen::Ref<const Eigen::VectorXd>& force,
+                                     Eigen::Ref<Eigen::VectorXd> torque) const override;
+
+  void setTrajectoryGenerator(TrajectoryGenerator& generator) override;
+  void clearTrajectoryGenerator() override;
+  TrajectoryGenerator* getTrajectoryGenerator() const override;
+  void setServoControl(ServoControl& control) override;
+  ServoControl& getServoControl() const override;
+  /// The DefaultPositionControl the manipulator created.
+  DefaultPositionControl& getDefaultPositionControl() { return *defaultControl_; }
+  void setGravityCompensationOn() override { gravityCompensation_.store(true); }
+  void setGravityCompensationOff() override { gravityCompensation_.store(false); }
+  bool isGravityCompensationOn() const override { return gravityCompensation_.load(); }
+  void setZeroGravityModeOn() override { zeroGravity_.store(true); }
+  void setZeroGravityModeOff() override;
+  bool isZeroGravityModeOn() const override { return zeroGravity_.load(); }
+
+  void applyExternalWrench(const Vector<6>& wrench) override;
+
+  /// Starts the damped hold and then switches the power off.
+  void startShutdown() override;
+  bool isShutdownComplete() const override;
+
+  Model3D get3DModel() const override;
+  ControlPanel getControlPanel() const override;
+  bool getStateSnapshot(StateSnapshot& snapshot) const override;
+
+  /// Waits until the servo loop has run `cycles` more cycles (tests, programs on a simulated clock).
+  /// @param[in] cycles  number of cycles
+  /// @param[in] timeoutSeconds  longest wait in real time [s]
+  /// @return false on time-out or if the loop is not running
+  bool waitForCycles(std::uint64_t cycles, double timeoutSeconds = 60) const;
+
+ protected:
+  void enterControl() override;
+  void control() override;
+  void exitControl() override;
+
+ private:
+  struct PublishedState {
+    double time = 0;
+    int n = 0;
+    bool power = false;
+    double q[kMaxJoints] = {}, qd[kMaxJoints] = {}, tau[kMaxJoints] = {}, qdes[kMaxJoints] = {};
+  };
+  struct WrenchBox;
+
+  bool inServoThread() const;
+  void checkLimits();
+  void violation(const char* what, int joint, double value, double limit, const char* unit);
+  void publish();
+
+  std::unique_ptr<ManipulatorModel> model_;
+  std::unique_ptr<ManipulatorData> data_;  // servo thread's
+  std::unique_ptr<ManipulatorSimulation> sim_;
+  std::unique_ptr<DefaultPositionControl> defaultControl_;
+  std::unique_ptr<WrenchBox> wrench_;
+
+  std::atomic<ServoControl*> servoControl_{nullptr};
+  ServoControl* activeControl_ = nullptr;
+  std::atomic<TrajectoryGenerator*> generator_{nullptr};
+  std::atomic<bool> powerRequested_{true};
+  std::atomic<bool> gravityCompensation_{true};
+  std::atomic<bool> zeroGravity_{false};
+  std::atomic<bool> holdHere_{false};
+  std::atomic<int> shutdownPhase_{0};  // 0 running, 1 damped hold, 2 complete
+  std::atomic<std::thread::id> servoThread_{};
+
+  // Servo-thread state.
+  JointVector q_, qd_, tau_, gravity_, hold_;
+  Setpoint setpoint_;
+  bool power_ = false;
+  double restTime_ = 0, shutdownStart_ = 0;
+  char nameBuffer_[64] = {};
+  char errorBuffer_[256] = {};
+
+  TripleBuffer<PublishedState> published_;
+  PublishedState initial_;
+};
+
+}  // namespace rp

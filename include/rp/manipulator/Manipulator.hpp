@@ -1,0 +1,127 @@
+#pragma once
+/// @file
+/// The generic manipulator interface (paper sections 3.3 and 3.6, Figure 10).
+
+#include <Eigen/Core>
+
+#include <string>
+
+#include "rp/core/PhysicalObject.hpp"
+#include "rp/model/ManipulatorModel.hpp"
+
+namespace rp {
+
+class ServoControl;
+class TrajectoryGenerator;
+struct Setpoint;
+
+/// A manipulator with any number of joints: the interface that generic programs use (paper
+/// section 3.6), whatever the arm (Puma560, WAM, UrdfManipulator, ...).
+///
+/// A manipulator is only the interface to the arm: its servo control (a ServoControl) and its
+/// trajectory generator (a TrajectoryGenerator) are separate objects connected to it and
+/// switchable at any time (paper Figure 8).
+///
+/// Threads: the methods marked "servo thread" are for ServoControl::calculate(); called from any
+/// other thread, the state getters return the latest state the servo loop published.
+class Manipulator : public PhysicalObject {
+ public:
+  /// Creates the manipulator.
+  /// @param[in] name  object name; empty for an automatic name
+  explicit Manipulator(const std::string& name = "") : PhysicalObject(name) {}
+  ~Manipulator() override = default;
+
+  /// The kinematic and dynamic model. Real-time safe: yes.
+  virtual const ManipulatorModel& getModel() const = 0;
+  /// Number of joints. Real-time safe: yes.
+  int getNumberOfJoints() const { return getModel().getNumberOfJoints(); }
+  /// Period of the servo loop [s]. Real-time safe: yes.
+  virtual double getServoPeriod() const = 0;
+
+  /// @name Joint state
+  /// @{
+  /// Joint positions (n x 1) [rad]. Real-time safe: yes.
+  virtual JointVector getJointPosition() const = 0;
+  /// Joint velocities (n x 1) [rad/s]. Real-time safe: yes.
+  virtual JointVector getJointVelocity() const = 0;
+  /// The setpoint of the current cycle (n x 1 each). Real-time safe: yes.
+  virtual const Setpoint& getSetpoint() const = 0;
+  /// The control output (joint torques) last written (n x 1) [N m]. Real-time safe: yes.
+  virtual JointVector getControlOutput() const = 0;
+  /// Sets this cycle's control output: joint torques [N m] (servo thread).
+  /// @param[in] torque  one value per joint
+  /// @throws MathException if the size is not the number of joints
+  /// Real-time safe: yes.
+  virtual void setControlOutput(const Eigen::Ref<const Eigen::VectorXd>& torque) = 0;
+  /// @}
+
+  /// @name Arm power
+  /// @{
+  /// Switches the arm power on (motors enabled, brakes released); the arm holds its position.
+  virtual void enableArmPower() = 0;
+  /// Switches the arm power off (brakes engaged, no torque).
+  virtual void disableArmPower() = 0;
+  /// Whether the arm power is on. Real-time safe: yes.
+  virtual bool isArmPowerOn() const = 0;
+  /// @}
+
+  /// @name Kinematics
+  /// @{
+  /// Pose of the end-effector in the world for the current joint positions [m].
+  /// Real-time safe: yes in the servo thread.
+  virtual Transform getEndEffectorTransform() const = 0;
+  /// The same as getEndEffectorTransform() (the paper's Figure 22 spells it this way).
+  Transform getEndEffectorPosition() const { return getEndEffectorTransform(); }
+  /// Joint torques that make the end-effector exert `force` (3: force [N]; 6: force and moment
+  /// [N m]), in world coordinates, at the joint positions `q`: \f$\tau = J(q)^T F\f$.
+  /// @param[in]  q       joint positions (n x 1) [rad]
+  /// @param[in]  force   force (3 x 1) or wrench (6 x 1)
+  /// @param[out] torque  joint torques (n x 1) [N m]
+  /// @throws MathException on wrong sizes
+  /// Real-time safe: yes in the servo thread.
+  virtual void endEffectorForceToJointTorque(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                             const Eigen::Ref<const Eigen::VectorXd>& force,
+                                             Eigen::Ref<Eigen::VectorXd> torque) const = 0;
+  /// @}
+
+  /// @name Servo control and trajectory generation
+  /// @{
+  /// Connects a trajectory generator; the manipulator follows its setpoints from the next cycle.
+  /// @param[in] generator  the generator (must outlive the connection)
+  virtual void setTrajectoryGenerator(TrajectoryGenerator& generator) = 0;
+  /// Disconnects the trajectory generator; the manipulator holds its current setpoint.
+  virtual void clearTrajectoryGenerator() = 0;
+  /// The connected trajectory generator, or nullptr.
+  virtual TrajectoryGenerator* getTrajectoryGenerator() const = 0;
+  /// Switches to another servo control between two cycles.
+  /// @param[in] control  the servo control (must outlive its use)
+  virtual void setServoControl(ServoControl& control) = 0;
+  /// The servo control in use.
+  virtual ServoControl& getServoControl() const = 0;
+  /// Adds the model's gravity torque to the servo control's output.
+  virtual void setGravityCompensationOn() = 0;
+  /// Stops adding the gravity torque.
+  virtual void setGravityCompensationOff() = 0;
+  /// Whether gravity compensation is on. Real-time safe: yes.
+  virtual bool isGravityCompensationOn() const = 0;
+  /// Zero-gravity mode: output only the gravity torque (the servo control is bypassed), so the
+  /// arm floats and can be pushed around (the Teachpendant uses it).
+  virtual void setZeroGravityModeOn() = 0;
+  /// Leaves zero-gravity mode; the servo control takes over at the current position.
+  virtual void setZeroGravityModeOff() = 0;
+  /// Whether zero-gravity mode is on. Real-time safe: yes.
+  virtual bool isZeroGravityModeOn() const = 0;
+  /// @}
+
+  /// @name Simulation
+  /// @{
+  /// In simulation mode: sets the wrench the environment applies to the end-effector, in world
+  /// coordinates (force [N], moment [N m] about the end-effector origin), until changed.
+  /// @param[in] wrench  (6 x 1); zero for none
+  virtual void applyExternalWrench(const Vector<6>& wrench) = 0;
+  /// Removes the external wrench.
+  void clearExternalWrench() { applyExternalWrench(Vector<6>()); }
+  /// @}
+};
+
+}  // namespace rp

@@ -1,0 +1,72 @@
+#pragma once
+/// @file
+/// The dynamic simulation of a manipulator's arm: what a manipulator in simulation mode drives.
+
+#include "rp/model/Dynamics.hpp"
+#include "rp/model/Kinematics.hpp"
+
+namespace rp {
+
+/// Integrates a manipulator model's forward dynamics under applied joint torques.
+///
+/// Each step() integrates the rigid-body dynamics with motor inertia and viscous friction by the
+/// semi-implicit (symplectic) Euler method; Coulomb friction is applied as a velocity impulse that
+/// never reverses the motion, so a joint sticks when the torque is below its Coulomb friction;
+/// torques are saturated at the model's torque limits; joints meet their limits as stiff
+/// spring-damper stops, with sub-steps while a stop is engaged; and brakes hold every joint while
+/// the brakes are on. An external wrench at the end-effector adds \f$J^T F\f$.
+///
+/// Deterministic: the same inputs give bit-identical states. Nothing allocates after construction.
+class ManipulatorSimulation {
+ public:
+  /// Creates a simulation at rest in `model`'s home position.
+  /// @param[in] model  the manipulator model (must outlive the simulation)
+  explicit ManipulatorSimulation(const ManipulatorModel& model);
+
+  /// Advances the simulation by `dt` under the joint torques `tau`.
+  /// @param[in] tau  motor torques at the joints (n x 1) [N m]
+  /// @param[in] dt   time step [s] (> 0)
+  /// Real-time safe: yes.
+  void step(const JointVector& tau, double dt);
+
+  /// Joint positions (n x 1) [rad]. Real-time safe: yes.
+  const JointVector& getPosition() const { return q_; }
+  /// Joint velocities (n x 1) [rad/s]. Real-time safe: yes.
+  const JointVector& getVelocity() const { return qd_; }
+  /// Joint accelerations of the last step (n x 1) [rad/s^2]. Real-time safe: yes.
+  const JointVector& getAcceleration() const { return qdd_; }
+  /// Puts the arm at rest in `q` [rad]. Real-time safe: yes.
+  void setState(const JointVector& q, const JointVector& qd);
+
+  /// Engages (true) or releases (false) the brakes; engaged brakes stop and hold every joint.
+  /// Real-time safe: yes.
+  void setBrakes(bool on) { brakes_ = on; }
+  /// Whether the brakes are engaged.
+  bool getBrakes() const { return brakes_; }
+
+  /// Sets the wrench the environment applies to the end-effector, in world coordinates: force
+  /// [N] then moment [N m] about the end-effector's origin; zero for none. Real-time safe: yes.
+  void setExternalWrench(const Vector<6>& wrench) { wrench_ = wrench; }
+  /// The external wrench. Real-time safe: yes.
+  const Vector<6>& getExternalWrench() const { return wrench_; }
+
+  /// Stiffness of the joint stops [N m/rad] (default 2e4).
+  /// @param[in] stiffness  > 0
+  void setStopStiffness(double stiffness) { stopStiffness_ = stiffness; }
+  /// Number of sub-steps used in the last step() (1 unless a joint stop was engaged).
+  int getLastSubsteps() const { return lastSubsteps_; }
+
+ private:
+  void integrate(const JointVector& tau, double h);
+
+  const ManipulatorModel& model_;
+  ManipulatorData data_;
+  JointVector q_, qd_, qdd_, tauTotal_, tauExt_, coulombPos_, coulombNeg_;
+  Vector<6> wrench_;
+  bool brakes_ = false;
+  double stopStiffness_ = 2e4;
+  int lastSubsteps_ = 1;
+  DynamicsOptions options_;
+};
+
+}  // namespace rp

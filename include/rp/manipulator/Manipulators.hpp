@@ -1,0 +1,12 @@
+#pragma once
+/// @file
+/// Manipulators, their servo controls and their simulation.
+
+#include "rp/control/DefaultPositionControl.hpp"
+#include "rp/control/ServoControl.hpp"
+#include "rp/manipulator/DefaultManipulator.hpp"
+#include "rp/manipulator/Manipulator.hpp"
+#include "rp/manipulator/ManipulatorSimulation.hpp"
+#include "rp/manipulator/Puma560.hpp"
+#include "rp/manipulator/WAM.hpp"
+#include "rp/trajectory/TrajectoryGenerator.hpp"

@@ -1,0 +1,10 @@
+#pragma once
+/// @file
+/// Manipulator models and their kinematics and dynamics algorithms.
+
+#include "rp/model/Dynamics.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/model/ManipulatorData.hpp"
+#include "rp/model/ManipulatorModel.hpp"
+#include "rp/model/Puma560Model.hpp"
+#include "rp/model/WAMModel.hpp"

@@ -1,0 +1,46 @@
+#pragma once
+/// @file
+/// The interface of trajectory generators (paper section 3.3, Figure 8).
+
+#include <string>
+
+#include "rp/core/PhysicalObject.hpp"
+#include "rp/trajectory/Setpoint.hpp"
+
+namespace rp {
+
+class Manipulator;
+
+/// Any object that produces a continuous stream of setpoints for manipulators.
+///
+/// A manipulator connected with Manipulator::setTrajectoryGenerator() calls
+/// getCurrentSetpoint() from its servo thread every cycle. One generator may drive several
+/// manipulators (paper Figure 23): each calls it with its own clock time, and on a shared clock
+/// they all see the same setpoints. getCurrentSetpoint() must be real-time safe and may be called
+/// from several servo threads at once.
+class TrajectoryGenerator : public FunctionalObject {
+ public:
+  /// Creates a generator.
+  /// @param[in] name  object name; empty for an automatic name
+  explicit TrajectoryGenerator(const std::string& name = "") : FunctionalObject(name) {}
+
+  /// The setpoint at servo-clock time `time`.
+  /// @param[in]     time      the calling servo loop's clock time [s]
+  /// @param[in,out] setpoint  on entry the manipulator's hold setpoint (its sizes fixed); on a
+  ///                          true return the generator's setpoint
+  /// @return true if the generator produced a setpoint, false if the manipulator should hold
+  /// Real-time safe: must be (no allocation, locking or blocking).
+  virtual bool getCurrentSetpoint(double time, Setpoint& setpoint) = 0;
+
+  /// Called (in the caller's thread) when `manipulator` connects to this generator.
+  /// @param[in] manipulator  the manipulator that will call getCurrentSetpoint()
+  /// @throws std::invalid_argument if the generator cannot drive it (e.g. wrong number of joints)
+  /// Real-time safe: no.
+  virtual void attach(Manipulator& manipulator) { (void)manipulator; }
+  /// Called (in the caller's thread) when `manipulator` disconnects.
+  /// @param[in] manipulator  the manipulator that no longer calls getCurrentSetpoint()
+  /// Real-time safe: no.
+  virtual void detach(Manipulator& manipulator) { (void)manipulator; }
+};
+
+}  // namespace rp

@@ -1,0 +1,419 @@
+// The servo loop of open-architecture manipulators (rp/manipulator/DefaultManipulator.hpp).
+#include "rp/manipulator/DefaultManipulator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <stdexcept>
+
+#include "rp/control/ServoControl.hpp"
+#include "rp/model/Dynamics.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/trajectory/TrajectoryGenerator.hpp"
+
+namespace rp {
+
+// The external wrench crosses from user threads to the servo thread through a sequence lock:
+// writers (serialised by a mutex) never block the reader, which retries a torn read.
+struct DefaultManipulator::WrenchBox {
+  std::mutex writerMutex;
+  std::atomic<unsigned> sequence{0};
+  std::atomic<double> values[6] = {};
+
+  void write(const Vector<6>& w) {
+    std::lock_guard<std::mutex> lock(writerMutex);
+    sequence.fetch_add(1, std::memory_order_acq_rel);
+    for (int i = 0; i < 6; ++i) values[i].store(w(i), std::memory_order_relaxed);
+    sequence.fetch_add(1, std::memory_order_release);
+  }
+  // Real-time safe: lock-free; gives up (keeping `out`) after a few torn reads.
+  void read(Vector<6>& out) const {
+    for (int attempt = 0; attempt < 8; ++attempt) {
+      const unsigned before = sequence.load(std::memory_order_acquire);
+      if (before & 1u) continue;
+      Vector<6> w;
+      for (int i = 0; i < 6; ++i) w(i) = values[i].load(std::memory_order_relaxed);
+      std::atomic_thread_fence(std::memory_order_acquire);
+      if (sequence.load(std::memory_order_relaxed) == before) {
+        out = w;
+        return;
+      }
+    }
+  }
+};
+
+namespace {
+constexpr double kRestVelocity = 1e-3;  // [rad/s] below which the arm counts as at rest
+constexpr double kRestDuration = 0.05;  // [s] at rest before the power goes off in a shutdown
+constexpr double kShutdownTimeout = 3.0;  // [s] longest damped hold
+}  // namespace
+
+DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFactory& modelFactory)
+    : Manipulator(name), ControlProgram(name.empty() ? "manipulator" : name) {
+  setProgramName(getName());
+  model_ = modelFactory(getTransform());
+  if (!model_) throw std::invalid_argument("DefaultManipulator '" + getName() + "': no model");
+  if (!isSimulationModeOn()) {
+    throw std::runtime_error(getClassName() + " '" + getName() +
+                             "': simulation mode is off but no hardware is configured for it; switch "
+                             "simulation on (-sim, or 'simulationMode on' in rp.cfg) or configure a hardware "
+                             "server");
+  }
+  const int n = model_->getNumberOfJoints();
+  data_ = std::make_unique<ManipulatorData>(*model_);
+  sim_ = std::make_unique<ManipulatorSimulation>(*model_);
+  wrench_ = std::make_unique<WrenchBox>();
+  for (JointVector* v : {&q_, &qd_, &tau_, &gravity_, &hold_}) v->setZero(n);
+  for (JointVector* v : {&setpoint_.position, &setpoint_.velocity, &setpoint_.acceleration}) v->setZero(n);
+  q_ = sim_->getPosition();
+  hold_ = q_;
+  setpoint_.position = q_;
+  std::snprintf(nameBuffer_, sizeof nameBuffer_, "%s", getName().c_str());
+
+  initial_.n = n;
+  for (int i = 0; i < n; ++i) initial_.q[i] = initial_.qdes[i] = q_(i);
+
+  defaultControl_ = std::make_unique<DefaultPositionControl>(getName() + ".control");
+  defaultControl_->attach(*this);
+  servoControl_.store(defaultControl_.get());
+
+  registerLogVariable("q", q_.data(), static_cast<std::size_t>(n), "rad");
+  registerLogVariable("qd", qd_.data(), static_cast<std::size_t>(n), "rad/s");
+  registerLogVariable("qdes", setpoint_.position.data(), static_cast<std::size_t>(n), "rad");
+  registerLogVariable("tau", tau_.data(), static_cast<std::size_t>(n), "N m");
+  registerParameter("kp", defaultControl_->getKp().data(), static_cast<std::size_t>(n), 0, 1e7, "N m/rad",
+                    "proportional gains of the default position control");
+  registerParameter("kd", defaultControl_->getKd().data(), static_cast<std::size_t>(n), 0, 1e6, "N m s/rad",
+                    "derivative gains of the default position control");
+  registerParameter("ki", defaultControl_->getKi().data(), static_cast<std::size_t>(n), 0, 1e8, "N m/(rad s)",
+                    "integral gains of the default position control");
+  if (const ConfigSection* section = configSection(); section != nullptr && section->qmotorConfig() != nullptr) {
+    applyQMotorConfig(*section->qmotorConfig());
+  }
+}
+
+DefaultManipulator::~DefaultManipulator() { stopControlLoop(); }
+
+bool DefaultManipulator::inServoThread() const {
+  return isRunning() && servoThread_.load(std::memory_order_relaxed) == std::this_thread::get_id();
+}
+
+JointVector DefaultManipulator::getJointPosition() const {
+  if (inServoThread()) return q_;
+  PublishedState s = initial_;
+  published_.read(s);
+  JointVector q(s.n);
+  for (int i = 0; i < s.n; ++i) q(i) = s.q[i];
+  return q;
+}
+
+JointVector DefaultManipulator::getJointVelocity() const {
+  if (inServoThread()) return qd_;
+  PublishedState s = initial_;
+  published_.read(s);
+  JointVector qd(s.n);
+  for (int i = 0; i < s.n; ++i) qd(i) = s.qd[i];
+  return qd;
+}
+
+const Setpoint& DefaultManipulator::getSetpoint() const { return setpoint_; }
+
+JointVector DefaultManipulator::getControlOutput() const {
+  if (inServoThread()) return tau_;
+  PublishedState s = initial_;
+  published_.read(s);
+  JointVector tau(s.n);
+  for (int i = 0; i < s.n; ++i) tau(i) = s.tau[i];
+  return tau;
+}
+
+void DefaultManipulator::setControlOutput(const Eigen::Ref<const Eigen::VectorXd>& torque) {
+  if (torque.size() != tau_.size()) {
+    throw MathException(std::string("setControlOutput: ") + std::to_string(torque.size()) + " torques for " +
+                        std::to_string(tau_.size()) + " joints");
+  }
+  tau_ = torque;
+}
+
+void DefaultManipulator::enableArmPower() {
+  if (shutdownPhase_.load() != 0) throw std::logic_error(getName() + ": cannot power the arm during a shutdown");
+  powerRequested_.store(true);
+}
+
+void DefaultManipulator::disableArmPower() { powerRequested_.store(false); }
+
+bool DefaultManipulator::isArmPowerOn() const {
+  if (inServoThread()) return power_;
+  PublishedState s = initial_;
+  if (!published_.read(s)) return powerRequested_.load();
+  return s.power;
+}
+
+Transform DefaultManipulator::getEndEffectorTransform() const {
+  if (inServoThread()) return forwardKinematics(*model_, *data_, q_);
+  ManipulatorData data(*model_);
+  return forwardKinematics(*model_, data, getJointPosition());
+}
+
+void DefaultManipulator::endEffectorForceToJointTorque(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                                       const Eigen::Ref<const Eigen::VectorXd>& force,
+                                                       Eigen::Ref<Eigen::VectorXd> torque) const {
+  if (q.size() != model_->getNumberOfJoints()) {
+    throw MathException("endEffectorForceToJointTorque: " + std::to_string(q.size()) + " joint positions for " +
+                        std::to_string(model_->getNumberOfJoints()) + " joints");
+  }
+  const JointVector qv = q;
+  if (inServoThread()) {
+    rp::endEffectorForceToJointTorque(*model_, *data_, qv, force, torque, ReferenceFrame::Base);
+  } else {
+    ManipulatorData data(*model_);
+    rp::endEffectorForceToJointTorque(*model_, data, qv, force, torque, ReferenceFrame::Base);
+  }
+}
+
+void DefaultManipulator::setTrajectoryGenerator(TrajectoryGenerator& generator) {
+  generator.attach(*this);
+  TrajectoryGenerator* old = generator_.exchange(&generator);
+  if (old != nullptr && old != &generator) old->detach(*this);
+}
+
+void DefaultManipulator::clearTrajectoryGenerator() {
+  holdHere_.store(true);
+  TrajectoryGenerator* old = generator_.exchange(nullptr);
+  if (old != nullptr) old->detach(*this);
+}
+
+TrajectoryGenerator* DefaultManipulator::getTrajectoryGenerator() const { return generator_.load(); }
+
+void DefaultManipulator::setServoControl(ServoControl& control) {
+  if (control.getManipulator() != this) control.attach(*this);
+  servoControl_.store(&control);
+}
+
+ServoControl& DefaultManipulator::getServoControl() const { return *servoControl_.load(); }
+
+void DefaultManipulator::setZeroGravityModeOff() {
+  holdHere_.store(true);  // the servo control takes over where the arm was pushed to
+  zeroGravity_.store(false);
+}
+
+void DefaultManipulator::applyExternalWrench(const Vector<6>& wrench) { wrench_->write(wrench); }
+
+void DefaultManipulator::startShutdown() {
+  RoboticObject::startShutdown();
+  int expected = 0;
+  shutdownPhase_.compare_exchange_strong(expected, 1);
+  if (!isRunning()) shutdownPhase_.store(2);
+}
+
+bool DefaultManipulator::isShutdownComplete() const { return shutdownPhase_.load() == 2; }
+
+bool DefaultManipulator::waitForCycles(std::uint64_t cycles, double timeoutSeconds) const {
+  const std::uint64_t target = getCycleCount() + cycles;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeoutSeconds);
+  while (getCycleCount() < target) {
+    if (!isRunning() || std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  return true;
+}
+
+void DefaultManipulator::enterControl() {
+  servoThread_.store(std::this_thread::get_id());
+  power_ = powerRequested_.load();
+  sim_->setBrakes(!power_);
+}
+
+void DefaultManipulator::exitControl() {
+  // The loop is gone: a shutdown in progress cannot finish its damped hold, so the brakes go on.
+  sim_->setBrakes(true);
+  power_ = false;
+  publish();
+  if (shutdownPhase_.load() == 1) shutdownPhase_.store(2);
+}
+
+void DefaultManipulator::control() {
+  const double t = getTime();
+  const double dt = getPeriod();
+  const int n = model_->getNumberOfJoints();
+
+  // 1. Commands from other threads, then the joints.
+  ServoControl* control = servoControl_.load(std::memory_order_acquire);
+  if (control != activeControl_) {
+    activeControl_ = control;
+    control->activate();
+  }
+  const int phase = shutdownPhase_.load(std::memory_order_acquire);
+  const bool wantPower = powerRequested_.load(std::memory_order_relaxed) && phase == 0;
+  if (wantPower != power_ && phase == 0) {
+    power_ = wantPower;
+    sim_->setBrakes(!power_);
+    hold_ = sim_->getPosition();
+    if (power_) activeControl_->activate();
+  }
+  Vector<6> wrench = sim_->getExternalWrench();
+  wrench_->read(wrench);
+  sim_->setExternalWrench(wrench);
+  q_ = sim_->getPosition();
+  qd_ = sim_->getVelocity();
+
+  // 2. The setpoint: the trajectory generator's, or hold.
+  const bool zeroG = zeroGravity_.load(std::memory_order_relaxed);
+  if (!power_ || zeroG || holdHere_.exchange(false, std::memory_order_acq_rel)) hold_ = q_;
+  setpoint_.position = hold_;
+  setpoint_.velocity.setZero();
+  setpoint_.acceleration.setZero();
+  TrajectoryGenerator* generator = generator_.load(std::memory_order_acquire);
+  if (generator != nullptr && power_ && !zeroG && phase == 0 && generator->getCurrentSetpoint(t, setpoint_)) {
+    hold_ = setpoint_.position;
+  }
+
+  // 3. Servo control.
+  tau_.setZero();
+  const bool gravityOn = gravityCompensation_.load(std::memory_order_relaxed);
+  if (phase != 0) {
+    // Damped hold: velocity damping with the default derivative gains, plus gravity.
+    tau_ = -(defaultControl_->getKd().cwiseProduct(qd_));
+  } else if (!zeroG) {
+    activeControl_->calculate();
+  }
+  if (gravityOn || zeroG || phase != 0) {
+    gravityTorque(*model_, *data_, q_, gravity_);
+    tau_ += gravity_;
+  }
+
+  // 4. Limits.
+  if (power_ && phase == 0) checkLimits();
+
+  // Shutdown: at rest for a while (or timed out), then power off.
+  if (shutdownPhase_.load(std::memory_order_relaxed) == 1) {
+    if (shutdownStart_ == 0) shutdownStart_ = t > 0 ? t : 1e-9;
+    restTime_ = qd_.cwiseAbs().maxCoeff() < kRestVelocity ? restTime_ + dt : 0;
+    if (restTime_ >= kRestDuration || t - shutdownStart_ > kShutdownTimeout || !power_) {
+      power_ = false;
+      sim_->setBrakes(true);
+      shutdownPhase_.store(2, std::memory_order_release);
+    }
+  }
+
+  // 5. Output: no torque without power; the simulation integrates the dynamics.
+  if (!power_) tau_.setZero();
+  sim_->step(tau_, dt);
+  (void)n;
+
+  // 6. State for other threads (log samples are taken by the ControlProgram after control()).
+  publish();
+}
+
+void DefaultManipulator::checkLimits() {
+  const int n = model_->getNumberOfJoints();
+  for (int i = 0; i < n; ++i) {
+    if (std::abs(tau_(i)) > model_->getTorqueLimit()(i)) {
+      violation("torque", i, tau_(i), std::copysign(model_->getTorqueLimit()(i), tau_(i)), "N m");
+      return;
+    }
+    if (q_(i) < model_->getPositionMin()(i)) {
+      violation("position", i, q_(i), model_->getPositionMin()(i), "rad");
+      return;
+    }
+    if (q_(i) > model_->getPositionMax()(i)) {
+      violation("position", i, q_(i), model_->getPositionMax()(i), "rad");
+      return;
+    }
+    if (std::abs(qd_(i)) > model_->getVelocityLimit()(i)) {
+      violation("velocity", i, qd_(i), std::copysign(model_->getVelocityLimit()(i), qd_(i)), "rad/s");
+      return;
+    }
+  }
+}
+
+void DefaultManipulator::violation(const char* what, int joint, double value, double limit, const char* unit) {
+  // Real-time safe: formats into a member buffer, never allocates.
+  std::snprintf(errorBuffer_, sizeof errorBuffer_, "%s: joint %d %s %.6g %s exceeds the limit %.6g %s", nameBuffer_,
+                joint + 1, what, value, unit, limit, unit);
+  setError(1, errorBuffer_);
+  shutdownPhase_.store(1, std::memory_order_release);
+  // Damped hold from this very cycle.
+  tau_ = -(defaultControl_->getKd().cwiseProduct(qd_));
+  gravityTorque(*model_, *data_, q_, gravity_);
+  tau_ += gravity_;
+  requestSystemShutdown(errorBuffer_);
+}
+
+void DefaultManipulator::publish() {
+  PublishedState s;
+  s.time = getTime();
+  s.n = static_cast<int>(q_.size());
+  s.power = power_;
+  for (int i = 0; i < s.n; ++i) {
+    s.q[i] = q_(i);
+    s.qd[i] = qd_(i);
+    s.tau[i] = tau_(i);
+    s.qdes[i] = setpoint_.position(i);
+  }
+  published_.write(s);
+}
+
+Model3D DefaultManipulator::get3DModel() const {
+  Model3D m;
+  const int n = model_->getNumberOfJoints();
+  for (int i = 1; i <= n; ++i) m.frames.push_back("link" + std::to_string(i));
+  m.frames.push_back("endEffector");
+  Shape base;
+  base.kind = ShapeKind::Cylinder;
+  base.size = Vector<3>{{0.1}, {0.2}, {0}};
+  base.pose = translation(0, 0, 0.1);
+  m.shapes.push_back(base);
+  for (int i = 0; i < n; ++i) {
+    Shape joint;
+    joint.kind = ShapeKind::Sphere;
+    joint.frame = "link" + std::to_string(i + 1);
+    joint.size = Vector<3>{{0.06}, {0}, {0}};
+    joint.color = Color{0.9, 0.5, 0.1, 1.0};
+    m.shapes.push_back(joint);
+  }
+  return m;
+}
+
+ControlPanel DefaultManipulator::getControlPanel() const {
+  ControlPanel panel = Manipulator::getControlPanel();
+  const int n = model_->getNumberOfJoints();
+  auto field = [&](const char* name, const char* label, const char* unit, int index) {
+    ControlPanelField f;
+    f.name = name;
+    f.label = label;
+    f.kind = FieldKind::Vector;
+    f.size = n;
+    f.unit = unit;
+    f.stateIndex = index;
+    panel.fields.push_back(f);
+  };
+  field("q", "Joint positions", "rad", 0);
+  field("qd", "Joint velocities", "rad/s", n);
+  field("tau", "Joint torques", "N m", 2 * n);
+  ControlPanelField power;
+  power.name = "power";
+  power.label = "Arm power";
+  power.kind = FieldKind::Boolean;
+  power.stateIndex = 3 * n;
+  panel.fields.push_back(power);
+  return panel;
+}
+
+bool DefaultManipulator::getStateSnapshot(StateSnapshot& snapshot) const {
+  PublishedState s = initial_;
+  published_.read(s);
+  snapshot.time = s.time;
+  snapshot.size = 3 * s.n + 1;
+  for (int i = 0; i < s.n; ++i) {
+    snapshot.values[i] = s.q[i];
+    snapshot.values[s.n + i] = s.qd[i];
+    snapshot.values[2 * s.n + i] = s.tau[i];
+  }
+  snapshot.values[3 * s.n] = s.power ? 1 : 0;
+  return true;
+}
+
+}  // namespace rp

@@ -1,0 +1,39 @@
+// The Barrett WAM robot object (rp/manipulator/WAM.hpp).
+#include "rp/manipulator/WAM.hpp"
+
+#include <stdexcept>
+
+#include "rp/core/RoboticPlatform.hpp"
+#include "rp/core/TypeDatabase.hpp"
+
+namespace rp {
+
+namespace {
+int linkCount(const std::string& name, int links) {
+  const ConfigSection* section = RoboticPlatform::getConfiguration().findSection(name);
+  if (section != nullptr && section->has("links")) links = std::stoi(section->getWord("links"));
+  if (links != 4 && links != 7) {
+    throw std::invalid_argument("WAM '" + name + "': " + std::to_string(links) + " links; a WAM has 4 or 7");
+  }
+  return links;
+}
+}  // namespace
+
+WAM::WAM(const std::string& name, int links)
+    : DefaultManipulator(name, [name, links](const Transform& base) -> std::unique_ptr<ManipulatorModel> {
+        if (linkCount(name, links) == 4) return std::make_unique<WAM4Model>(base);
+        return std::make_unique<WAM7Model>(base);
+      }) {
+  startControlLoop();
+}
+
+WAM::~WAM() { stopControlLoop(); }
+
+void WAM::declareSettings(SettingSchema& schema) {
+  DefaultManipulator::declareSettings(schema);
+  schema.addChoice("links", {"4", "7"}, "number of links: the 4-DOF arm or the 7-DOF arm with wrist");
+}
+
+}  // namespace rp
+
+RP_REGISTER_CLASS_AS(rp::WAM, "WAM");

@@ -1,0 +1,367 @@
+// Manipulators in simulation mode on the platform's simulated clock: holding under gravity
+// compensation, step tracking, switching servo controls, each kind of limit violation, two arms
+// at once, determinism, zero-gravity mode, and an allocation-free servo cycle.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <numbers>
+
+#include "AllocationCounter.hpp"
+#include "rp/RoboticPlatform.hpp"
+
+namespace rp {
+namespace {
+
+SimulatedClock& simClock() {
+  RoboticPlatform::useSimulatedClock();
+  return dynamic_cast<SimulatedClock&>(RoboticPlatform::getDefaultClock());
+}
+
+class ManipulatorTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    RoboticPlatform::setConfiguration(Configuration());
+    RoboticPlatform::setSimulationModeOn();
+    ObjectManager::resetShutdown();
+    simClock().resume();
+  }
+  void TearDown() override { simClock().resume(); }
+};
+
+// A trajectory generator that gives a constant target (a step) once `start` has passed.
+class StepGenerator : public TrajectoryGenerator {
+ public:
+  StepGenerator(const JointVector& target, double start) : target_(target), start_(start) {}
+  bool getCurrentSetpoint(double time, Setpoint& sp) override {
+    if (time < start_) return false;
+    sp.position = target_;
+    return true;
+  }
+
+ private:
+  JointVector target_;
+  double start_;
+};
+
+// Records the joint positions the servo thread sees at a given cycle, and the largest excursion
+// of one joint past a value, by wrapping another servo control.
+class Probe : public ServoControl {
+ public:
+  explicit Probe(ServoControl& inner, std::uint64_t recordAt = 0) : inner_(inner), recordAt_(recordAt) {}
+  // Track how far each joint goes past `target` (for steps in the positive direction).
+  void trackOvershoot(const JointVector& target) {
+    target_ = target;
+    overshoot_.setZero(target.size());
+  }
+  void attach(Manipulator& m) override {
+    ServoControl::attach(m);
+    if (inner_.getManipulator() != &m) inner_.attach(m);
+  }
+  void activate() override { inner_.activate(); }
+  void calculate() override {
+    ++cycles_;
+    const JointVector q = d_manipulator->getJointPosition();
+    if (target_.size() == q.size()) overshoot_ = overshoot_.cwiseMax(q - target_);
+    if (cycles_ == recordAt_) {
+      recorded_ = q;
+      recordedFlag_.store(true);
+    }
+    inner_.calculate();
+  }
+  bool recorded() const { return recordedFlag_.load(); }
+  JointVector recorded_, overshoot_;
+
+ private:
+  ServoControl& inner_;
+  JointVector target_;
+  std::uint64_t recordAt_;
+  std::uint64_t cycles_ = 0;
+  std::atomic<bool> recordedFlag_{false};
+};
+
+TEST_F(ManipulatorTest, GravityCompensationHoldsTheArmAtRest) {
+  Puma560 puma;
+  const JointVector home = puma.getModel().getHomePosition();
+  ASSERT_TRUE(puma.waitForCycles(3000));
+  const JointVector q = puma.getJointPosition();
+  // With the gravity torque fed forward and the PID holding, the arm stays where it is: the
+  // only disturbance is the integration of the exactly compensated dynamics (drift < 1e-6 rad).
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(q(i), home(i), 1e-6) << "joint " << i + 1;
+  EXPECT_TRUE(puma.isArmPowerOn());
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, StepResponseSettlesWithLittleOvershoot) {
+  Puma560 puma;
+  JointVector target = puma.getModel().getHomePosition();
+  const double step = 0.02;  // [rad] small enough to stay below the torque limits
+  for (int i = 0; i < 6; ++i) target(i) += step;
+  StepGenerator gen(target, 0.0);
+  DefaultPositionControl& pid = puma.getDefaultPositionControl();
+  Probe probe(pid, 2000);
+  probe.trackOvershoot(target);
+  puma.setServoControl(probe);
+  puma.setTrajectoryGenerator(gen);
+  ASSERT_TRUE(puma.waitForCycles(2500));
+  ASSERT_TRUE(probe.recorded());
+  // Bounds: the PD part alone balances Coulomb friction F_c anywhere within F_c / K_p of the
+  // target (the dead band of a PD against dry friction); the integral can only shrink the error
+  // further, so after 2 s each joint is inside that band. The design is critically damped
+  // (omega_n = 25 rad/s); the integral and the coupling between joints may add overshoot, bounded
+  // here by 20 % of the step.
+  const ManipulatorModel& model = puma.getModel();
+  for (int i = 0; i < 6; ++i) {
+    const LinkParameters& l = model.getLink(i);
+    const double deadBand = std::abs(l.gearRatio) * std::max(l.coulombFrictionPositive, -l.coulombFrictionNegative) /
+                            pid.getKp()(i);
+    EXPECT_NEAR(probe.recorded_(i), target(i), deadBand) << "joint " << i + 1;
+    EXPECT_LT(probe.overshoot_(i), 0.2 * step) << "joint " << i + 1;
+  }
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+// Outputs a constant torque on one joint.
+class ConstantTorque : public ServoControl {
+ public:
+  ConstantTorque(int joint, double torque) : joint_(joint), torque_(torque) {}
+  void calculate() override {
+    Vector<6> t;
+    t(joint_) = torque_;
+    d_manipulator->setControlOutput(t);
+  }
+
+ private:
+  int joint_;
+  double torque_;
+};
+
+TEST_F(ManipulatorTest, TorqueLimitViolationShutsTheSystemDown) {
+  Puma560 puma;
+  ConstantTorque tooMuch(1, 500.0);  // limit 200 N m
+  puma.setServoControl(tooMuch);
+  ASSERT_TRUE(ObjectManager::waitForShutdown(10));
+  EXPECT_NE(puma.getErrorCode(), 0);
+  const std::string message = puma.getErrorStatus().message;
+  EXPECT_NE(message.find("joint 2 torque"), std::string::npos) << message;
+  EXPECT_NE(message.find("exceeds the limit 200 N m"), std::string::npos) << message;
+  EXPECT_NE(ObjectManager::getShutdownReason().find("joint 2 torque"), std::string::npos);
+  // The shutdown brings the arm to rest and switches the power off.
+  for (int i = 0; i < 10000 && !puma.isShutdownComplete(); ++i) puma.waitForCycles(1, 1);
+  EXPECT_TRUE(puma.isShutdownComplete());
+  EXPECT_FALSE(puma.isArmPowerOn());
+}
+
+TEST_F(ManipulatorTest, VelocityLimitViolationShutsTheSystemDown) {
+  Puma560 puma;
+  ConstantTorque spin(5, 20.0);  // joint 6: light, within its 25 N m limit, speeds past 4 rad/s
+  puma.setGravityCompensationOn();
+  puma.setServoControl(spin);
+  ASSERT_TRUE(ObjectManager::waitForShutdown(10));
+  EXPECT_NE(puma.getErrorStatus().message.find("joint 6 velocity"), std::string::npos)
+      << puma.getErrorStatus().message;
+}
+
+// Moves joint `joint` at a constant speed from the home position.
+class RampGenerator : public TrajectoryGenerator {
+ public:
+  RampGenerator(const JointVector& start, int joint, double speed) : start_(start), joint_(joint), speed_(speed) {}
+  bool getCurrentSetpoint(double time, Setpoint& sp) override {
+    if (t0_ < 0) t0_ = time;  // the shared simulated clock does not start at 0
+    sp.position = start_;
+    sp.position(joint_) += speed_ * (time - t0_);
+    sp.velocity.setZero();
+    sp.velocity(joint_) = speed_;
+    return true;
+  }
+
+ private:
+  JointVector start_;
+  int joint_;
+  double speed_;
+  double t0_ = -1;
+};
+
+TEST_F(ManipulatorTest, PositionLimitViolationShutsTheSystemDown) {
+  simClock().pause();
+  Puma560 puma;
+  RampGenerator gen(puma.getModel().getHomePosition(), 4, 1.0);  // joint 5 towards its 100 degree limit
+  puma.setTrajectoryGenerator(gen);
+  simClock().resume();
+  ASSERT_TRUE(ObjectManager::waitForShutdown(10));
+  EXPECT_NE(puma.getErrorStatus().message.find("joint 5 position"), std::string::npos)
+      << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, ViolationIsDetectedInTheCycleItHappens) {
+  // The probe counts the cycles in which the torque servo control ran: exactly one, because the
+  // very cycle that commands too much torque switches to the damped hold and requests shutdown.
+  Puma560 puma;
+  ConstantTorque tooMuch(0, 150.0);  // joint 1 limit 100 N m
+  Probe probe(tooMuch);
+  struct Counter : ServoControl {
+    ServoControl* inner = nullptr;
+    std::atomic<int> calls{0};
+    void calculate() override {
+      ++calls;
+      inner->calculate();
+    }
+    void attach(Manipulator& m) override {
+      ServoControl::attach(m);
+      inner->attach(m);
+    }
+  } counter;
+  counter.inner = &tooMuch;
+  simClock().pause();
+  puma.setServoControl(counter);
+  simClock().resume();
+  ASSERT_TRUE(ObjectManager::waitForShutdown(10));
+  puma.waitForCycles(100);
+  EXPECT_EQ(counter.calls.load(), 1);
+}
+
+TEST_F(ManipulatorTest, ServoControlsSwitchMidMotion) {
+  Puma560 puma;
+  JointVector target = puma.getModel().getHomePosition();
+  target(0) += 0.02;
+  StepGenerator gen(target, 0.0);
+  puma.setTrajectoryGenerator(gen);
+  ASSERT_TRUE(puma.waitForCycles(30));  // in motion
+  DefaultPositionControl stiffer;
+  stiffer.attach(puma);
+  JointVector kp = stiffer.getKp() * 2.0, kd = stiffer.getKd() * 1.5, ki = stiffer.getKi();
+  stiffer.setGains(kp, kd, ki);
+  puma.setServoControl(stiffer);
+  ASSERT_TRUE(puma.waitForCycles(2000));
+  EXPECT_EQ(&puma.getServoControl(), &stiffer);
+  // Within the Coulomb-friction dead band of the new proportional gain (see the step test).
+  const LinkParameters& l = puma.getModel().getLink(0);
+  EXPECT_NEAR(puma.getJointPosition()(0), target(0), std::abs(l.gearRatio) * 0.435 / kp(0));
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, TwoArmsRunTogetherDeterministically) {
+  auto run = [](JointVector& a, JointVector& b) {
+    simClock().pause();
+    Puma560 first;
+    WAM second("", 7);
+    JointVector ta = first.getModel().getHomePosition(), tb = second.getModel().getHomePosition();
+    ta(1) += 0.01;
+    tb(0) += 0.01;
+    StepGenerator ga(ta, 0.0), gb(tb, 0.0);
+    first.setTrajectoryGenerator(ga);
+    second.setTrajectoryGenerator(gb);
+    Probe pa(first.getDefaultPositionControl(), 700), pb(second.getDefaultPositionControl(), 700);
+    first.setServoControl(pa);
+    second.setServoControl(pb);
+    simClock().resume();
+    while (!pa.recorded() || !pb.recorded()) first.waitForCycles(10);
+    a = pa.recorded_;
+    b = pb.recorded_;
+    EXPECT_EQ(first.getErrorCode(), 0) << first.getErrorStatus().message;
+    EXPECT_EQ(second.getErrorCode(), 0) << second.getErrorStatus().message;
+  };
+  JointVector a1, b1, a2, b2;
+  run(a1, b1);
+  run(a2, b2);
+  EXPECT_EQ(a1.size(), 6);
+  EXPECT_EQ(b1.size(), 7);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(a1(i), a2(i)) << "bit-identical runs";
+  for (int i = 0; i < 7; ++i) EXPECT_EQ(b1(i), b2(i)) << "bit-identical runs";
+}
+
+TEST_F(ManipulatorTest, ZeroGravityModeLetsAnExternalForcePushTheArm) {
+  Puma560 puma;
+  puma.setZeroGravityModeOn();
+  const Transform before = puma.getEndEffectorTransform();
+  Vector<6> push;
+  push(0) = 20.0;  // 20 N along +x at the end-effector
+  puma.applyExternalWrench(push);
+  ASSERT_TRUE(puma.waitForCycles(300));
+  puma.clearExternalWrench();
+  const Transform after = puma.getEndEffectorTransform();
+  EXPECT_GT(after(0, 3) - before(0, 3), 0.01) << "the arm moved along the push";
+  // Back under the servo control it stops where it was pushed to.
+  puma.setZeroGravityModeOff();
+  ASSERT_TRUE(puma.waitForCycles(3000));
+  const Transform rest1 = puma.getEndEffectorTransform();
+  ASSERT_TRUE(puma.waitForCycles(1000));
+  const Transform rest2 = puma.getEndEffectorTransform();
+  EXPECT_NEAR(rest1(0, 3), rest2(0, 3), 1e-4) << "at rest (within 0.1 mm per second)";
+  EXPECT_GT(rest2(0, 3) - before(0, 3), 0.01) << "where it was pushed to";
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, PowerOffEngagesTheBrakes) {
+  Puma560 puma;
+  puma.disableArmPower();
+  ASSERT_TRUE(puma.waitForCycles(500));
+  EXPECT_FALSE(puma.isArmPowerOn());
+  const JointVector q = puma.getJointPosition();
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(q(i), puma.getModel().getHomePosition()(i), 1e-6);
+  EXPECT_EQ(puma.getControlOutput().squaredNorm(), 0.0);
+  puma.enableArmPower();
+  ASSERT_TRUE(puma.waitForCycles(50));
+  EXPECT_TRUE(puma.isArmPowerOn());
+}
+
+TEST_F(ManipulatorTest, CreatedByNameFromTheConfiguration) {
+  RoboticPlatform::setConfiguration(Configuration::parse("[leader]\nclass Puma560\n\n[follower]\nclass WAM\nlinks 4\n"
+                                                         "position 300 0 0\n",
+                                                         "rp.cfg"));
+  ObjectManager om;
+  Manipulator* leader = om.createDerivedObject<Manipulator>("leader");
+  Manipulator* follower = om.createDerivedObject<Manipulator>("follower");
+  EXPECT_EQ(leader->getNumberOfJoints(), 6);
+  EXPECT_EQ(follower->getNumberOfJoints(), 4);
+  EXPECT_NEAR(follower->getModel().getBaseTransform()(0, 3), 0.3, 1e-12) << "position is in millimetres";
+  om.deleteObject(leader);
+  om.deleteObject(follower);
+}
+
+// Counts the allocations the servo thread makes between two consecutive calculate() calls: the
+// whole cycle (simulation step, limit checks, state publication, log sampling, trajectory).
+class AllocationProbe : public ServoControl {
+ public:
+  explicit AllocationProbe(ServoControl& inner) : inner_(inner) {}
+  void attach(Manipulator& m) override {
+    ServoControl::attach(m);
+    if (inner_.getManipulator() != &m) inner_.attach(m);
+  }
+  void calculate() override {
+    const std::size_t now = test::allocationCount();
+    if (cycles_ > 2) allocations_ += now - last_;
+    ++cycles_;
+    inner_.calculate();
+    last_ = test::allocationCount();
+    if (cycles_ > 2) allocations_ += last_ - now;
+    cycleCount_.store(cycles_);
+  }
+  std::size_t allocations() const { return allocations_; }
+  std::uint64_t cycles() const { return cycleCount_.load(); }
+
+ private:
+  ServoControl& inner_;
+  std::size_t last_ = 0, allocations_ = 0;
+  std::uint64_t cycles_ = 0;
+  std::atomic<std::uint64_t> cycleCount_{0};
+};
+
+TEST_F(ManipulatorTest, TheServoCycleDoesNotAllocate) {
+  Puma560 puma;
+  JointVector target = puma.getModel().getHomePosition();
+  target(2) += 0.01;
+  StepGenerator gen(target, 0.0);
+  AllocationProbe probe(puma.getDefaultPositionControl());
+  puma.setServoControl(probe);
+  puma.setTrajectoryGenerator(gen);
+  Vector<6> push;
+  push(2) = 5.0;
+  puma.applyExternalWrench(push);
+  while (probe.cycles() < 2000) puma.waitForCycles(100);
+  simClock().pause();
+  EXPECT_EQ(probe.allocations(), 0u);
+}
+
+}  // namespace
+}  // namespace rp
