@@ -6,6 +6,10 @@
 //   rp-hwserver -name NAME [-rate HZ] [-duration S] -board modbus [-address A] -port P [-unit ID]
 //               [-timeout MS] [-coils LIST] [-discreteInputs LIST] [-inputRegisters LIST]
 //               [-holdingRegisters LIST] [-encoderRegisters LIST] [-voltsPerCount V]
+//   rp-hwserver -name NAME [-rate HZ] [-duration S] -board puma560 [-countsPerRadian C]
+//       a Puma 560 wired to a board: encoders 0-5 in counts, analog outputs 0-5 in DAC volts
+//       (torque = volts x amplifier gain, gain = torque limit / 10 V), digital output 0 enables
+//       the amplifiers (brakes hold the arm while it is off); the arm's dynamics are simulated.
 // LIST is comma-separated register or coil addresses, one per line (e.g. -coils 0,1,2,3).
 // Prints "rp-hwserver: serving NAME ..." once clients can attach; stops on SIGINT/SIGTERM or after
 // -duration seconds, setting every output to zero. Exit status 2 for bad arguments, 1 for errors.
@@ -20,11 +24,13 @@
 #include <thread>
 #include <vector>
 
+#include "ArmIoBoard.hpp"
 #include "Arguments.hpp"
 #include "rp/io/HwServer.hpp"
 #include "rp/io/IoException.hpp"
 #include "rp/io/ModbusIoBoard.hpp"
 #include "rp/io/SimulatedIoBoard.hpp"
+#include "rp/model/Puma560Model.hpp"
 
 namespace {
 
@@ -37,10 +43,11 @@ volatile std::sig_atomic_t gStop = 0;
 void onSignal(int) { gStop = 1; }
 
 constexpr const char* kUsage =
-    "usage: rp-hwserver -name NAME [-rate HZ] [-duration S] -board simulated|modbus [board options]\n"
+    "usage: rp-hwserver -name NAME [-rate HZ] [-duration S] -board simulated|modbus|puma560 [board options]\n"
     "  simulated: [-loopback] [-digitalInputs N] [-digitalOutputs N] [-analogInputs N] [-analogOutputs N] [-encoders N]\n"
     "  modbus:    [-address A] -port P [-unit ID] [-timeout MS] [-coils LIST] [-discreteInputs LIST]\n"
-    "             [-inputRegisters LIST] [-holdingRegisters LIST] [-encoderRegisters LIST] [-voltsPerCount V]\n";
+    "             [-inputRegisters LIST] [-holdingRegisters LIST] [-encoderRegisters LIST] [-voltsPerCount V]\n"
+    "  puma560:   [-countsPerRadian C]   (encoders 0-5, DAC volts 0-5, digital output 0 = amplifier enable)\n";
 
 }  // namespace
 
@@ -49,6 +56,7 @@ int main(int argc, char** argv) {
   double rate = 1000.0, duration = 0.0;
   rp::SimulatedIoBoard::Config sim;
   rp::ModbusIoBoard::Config modbus;
+  rp::emulator::ArmIoBoard::Config arm;
   modbus.port = 0;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -77,6 +85,7 @@ int main(int argc, char** argv) {
       else if (opt == "-holdingRegisters") modbus.analogOutputRegisters = toIntList(opt, value());
       else if (opt == "-encoderRegisters") modbus.encoderRegisters = toIntList(opt, value());
       else if (opt == "-voltsPerCount") modbus.voltsPerCount = toDouble(opt, value());
+      else if (opt == "-countsPerRadian") arm.countsPerRadian = toDouble(opt, value());
       else if (opt == "-h" || opt == "-help" || opt == "--help") {
         std::cout << kUsage;
         return 0;
@@ -85,7 +94,9 @@ int main(int argc, char** argv) {
       }
     }
     if (name.empty()) throw UsageError("-name is required");
-    if (board != "simulated" && board != "modbus") throw UsageError("-board must be simulated or modbus");
+    if (board != "simulated" && board != "modbus" && board != "puma560")
+      throw UsageError("-board must be simulated, modbus or puma560");
+    if (!(arm.countsPerRadian > 0)) throw UsageError("-countsPerRadian must be positive");
     if (duration < 0) throw UsageError("-duration must not be negative");
   } catch (const UsageError& e) {
     std::cerr << "rp-hwserver: " << e.what() << "\n" << kUsage;
@@ -94,8 +105,10 @@ int main(int argc, char** argv) {
 
   try {
     std::unique_ptr<rp::IoBoard> io;
+    rp::Puma560Model puma;
     if (board == "simulated") io = std::make_unique<rp::SimulatedIoBoard>(sim);
-    else io = std::make_unique<rp::ModbusIoBoard>(modbus);
+    else if (board == "modbus") io = std::make_unique<rp::ModbusIoBoard>(modbus);
+    else io = std::make_unique<rp::emulator::ArmIoBoard>(puma, arm);
     rp::HwServer server(*io, name, rate);
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
