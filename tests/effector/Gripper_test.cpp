@@ -108,7 +108,7 @@ TEST_F(GripperTest, ModbusGripperSetsCoilsAndReportsADeadDevice) {
   emulator::ModbusEmulator device;
   device.start();
   configure("[gripper]\nclass DefaultGripper\nsimulationMode off\nboard modbus\naddress 127.0.0.1\nport " +
-            std::to_string(device.port()) + "\ntimeout 200\nopenLine 6\ncloseLine 7\n");
+            std::to_string(device.port()) + "\ntimeout 1000\nopenLine 6\ncloseLine 7\n");
   auto* g = om_.createDerivedObject<Gripper>("gripper");
   ASSERT_EQ(g->getErrorCode(), 0);
   g->executeCommand("Close");

@@ -31,7 +31,7 @@ TEST_F(ToolChangerTest, ModbusToolChangerDrivesLockAndUnlockCoils) {
   emulator::ModbusEmulator device;
   device.start();
   configure("[changer]\nclass DefaultToolChanger\nsimulationMode off\nboard modbus\nport " +
-            std::to_string(device.port()) + "\nlockLine 10\nunlockLine 11\n");
+            std::to_string(device.port()) + "\ntimeout 1000\nlockLine 10\nunlockLine 11\n");
   auto* c = om_.createDerivedObject<ToolChanger>("changer");
   ASSERT_TRUE(c->lock()) << c->getErrorStatus().message;
   EXPECT_TRUE(device.coil(10));

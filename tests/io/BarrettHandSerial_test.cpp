@@ -21,8 +21,8 @@ class BarrettHandSerialTest : public ::testing::Test {
   void SetUp() override {
     hand_.start();
     config_.port = hand_.devicePath();
-    config_.timeoutMs = 200;
-    config_.motionTimeoutMs = 500;
+    config_.timeoutMs = 1000;  // generous for normal replies on a loaded machine
+    config_.motionTimeoutMs = 1000;
   }
   BarrettHandEmulator hand_;
   BarrettHandSerial::Config config_;
@@ -98,7 +98,7 @@ TEST_F(BarrettHandSerialTest, SilentHandTimesOut) {
   BarrettHandSerial driver(config_);
   ASSERT_EQ(driver.open(), IoStatus::kOk);
   const auto start = std::chrono::steady_clock::now();
-  EXPECT_EQ(driver.command("PGET TEMP"), IoStatus::kTimeout);
+  EXPECT_EQ(driver.command("PGET TEMP", nullptr, 200), IoStatus::kTimeout);
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5)) << "bounded, never a hang";
   EXPECT_TRUE(contains(driver.lastError(), "'PGET TEMP' failed: no reply within 200 ms")) << driver.lastError();
 }
@@ -107,7 +107,7 @@ TEST_F(BarrettHandSerialTest, GarbledReplyIsAProtocolError) {
   hand_.setFault(BarrettHandEmulator::Fault::kGarbled);
   BarrettHandSerial driver(config_);
   ASSERT_EQ(driver.open(), IoStatus::kOk);
-  EXPECT_EQ(driver.initialize(), IoStatus::kProtocolError);
+  EXPECT_EQ(driver.command("HI", nullptr, 200), IoStatus::kProtocolError);
   EXPECT_TRUE(contains(driver.lastError(), "'HI' failed: garbled reply")) << driver.lastError();
 }
 
@@ -115,7 +115,7 @@ TEST_F(BarrettHandSerialTest, TruncatedReplyTimesOutAndSaysSo) {
   hand_.setFault(BarrettHandEmulator::Fault::kTruncated);
   BarrettHandSerial driver(config_);
   ASSERT_EQ(driver.open(), IoStatus::kOk);
-  EXPECT_EQ(driver.command("PGET TEMP"), IoStatus::kTimeout);
+  EXPECT_EQ(driver.command("PGET TEMP", nullptr, 200), IoStatus::kTimeout);
   EXPECT_TRUE(contains(driver.lastError(), "truncated reply")) << driver.lastError();
   hand_.setFault(BarrettHandEmulator::Fault::kNone);
   std::string reply;

@@ -106,7 +106,7 @@ TEST(RpHwServer, ServesASimulatedBoardAndDetectsItsDeath) {
   const auto line = server.readLine(10000);
   ASSERT_TRUE(line.has_value());
   EXPECT_TRUE(contains(*line, "rp-hwserver: serving " + name)) << *line;
-  HwServerIoBoard client(name, 200);
+  HwServerIoBoard client(name, 1000);  // stale after 1 s without a cycle
   ASSERT_EQ(client.writeDigitalOutput(5, true), IoStatus::kOk) << client.lastError();
   ASSERT_EQ(client.waitForCycle(2000), IoStatus::kOk) << client.lastError();
   ASSERT_EQ(client.waitForCycle(2000), IoStatus::kOk) << client.lastError();
@@ -117,7 +117,7 @@ TEST(RpHwServer, ServesASimulatedBoardAndDetectsItsDeath) {
   server.signal(SIGKILL);
   ASSERT_TRUE(server.wait(5000).has_value());
   IoStatus s = IoStatus::kOk;
-  for (int i = 0; i < 200 && s == IoStatus::kOk; ++i) {
+  for (int i = 0; i < 400 && s == IoStatus::kOk; ++i) {  // bounded: 4 s
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     s = client.readDigitalInput(5, on);
   }

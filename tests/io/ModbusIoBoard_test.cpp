@@ -14,11 +14,12 @@ namespace {
 
 using emulator::ModbusEmulator;
 
-ModbusIoBoard::Config boardConfig(int port) {
+// Normal operations get a generous timeout (a loaded machine); fault tests pass a short one.
+ModbusIoBoard::Config boardConfig(int port, int timeoutMs = 1000) {
   ModbusIoBoard::Config c;
   c.address = "127.0.0.1";
   c.port = port;
-  c.responseTimeoutMs = 150;
+  c.responseTimeoutMs = timeoutMs;
   c.digitalOutputCoils = {8, 9, 3};
   c.digitalInputs = {0, 5};
   c.analogInputRegisters = {2};
@@ -112,7 +113,7 @@ TEST(ModbusIoBoard, DeviceAbsentIsConnectionRefused) {
 }
 
 TEST_F(ModbusIoBoardTest, SilentDeviceTimesOutWithinTheResponseTimeout) {
-  ModbusIoBoard board(boardConfig(server_.port()));
+  ModbusIoBoard board(boardConfig(server_.port(), 150));
   ASSERT_EQ(board.connect(), IoStatus::kOk);
   server_.setFault(ModbusEmulator::Fault::kSilent);
   const auto start = std::chrono::steady_clock::now();
@@ -126,14 +127,14 @@ TEST_F(ModbusIoBoardTest, SilentDeviceTimesOutWithinTheResponseTimeout) {
 }
 
 TEST_F(ModbusIoBoardTest, GarbledReplyIsAProtocolError) {
-  ModbusIoBoard board(boardConfig(server_.port()));
+  ModbusIoBoard board(boardConfig(server_.port(), 150));
   server_.setFault(ModbusEmulator::Fault::kGarbled);
   EXPECT_EQ(board.writeDigitalOutput(0, true), IoStatus::kProtocolError) << board.lastError();
   EXPECT_FALSE(board.isConnected()) << "the stream is out of step: reconnect next time";
 }
 
 TEST_F(ModbusIoBoardTest, TruncatedReplyTimesOut) {
-  ModbusIoBoard board(boardConfig(server_.port()));
+  ModbusIoBoard board(boardConfig(server_.port(), 150));
   server_.setFault(ModbusEmulator::Fault::kTruncated);
   double v = 0;
   const IoStatus s = board.readAnalogInput(0, v);
