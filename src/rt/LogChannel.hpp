@@ -38,8 +38,8 @@ struct LogWriter::Channel {
   }
   void pop() noexcept { tail.store(tail.load(std::memory_order_relaxed) + 1, std::memory_order_release); }
 
-  const std::string program;
-  const std::vector<std::string> columns;  // full column names, e.g. "leader.q[0]"
+  std::string program;               // renamed by the writer if another program has the name
+  std::vector<std::string> columns;  // full column names, e.g. "leader.q[0]"
   const std::size_t width;
   const std::size_t capacity;
   std::unique_ptr<double[]> data;

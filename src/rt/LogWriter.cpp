@@ -108,6 +108,21 @@ LogWriter::~LogWriter() { close(); }
 void LogWriter::addChannel(const std::shared_ptr<Channel>& channel) {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   if (impl_->closed.load()) return;
+  // Column names must be unique: a second program of the same name becomes name_2, name_3, ...
+  auto taken = [&](const std::string& name) {
+    for (auto& c : impl_->channels)
+      if (c->program == name) return true;
+    return false;
+  };
+  if (taken(channel->program)) {
+    std::string unique;
+    for (int k = 2; taken(unique = channel->program + "_" + std::to_string(k)); ++k) {
+    }
+    std::fprintf(stderr, "rp: log %s: a second program is called '%s'; its columns are '%s.*'\n",
+                 impl_->fileName.c_str(), channel->program.c_str(), unique.c_str());
+    for (auto& column : channel->columns) column = unique + column.substr(channel->program.size());
+    channel->program = unique;
+  }
   channel->firstColumn = impl_->totalColumns;
   impl_->totalColumns += channel->width;
   impl_->channels.push_back(channel);

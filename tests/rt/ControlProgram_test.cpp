@@ -174,6 +174,29 @@ TEST(ControlProgramThreads, LogRowsOnTheSimulatedClock) {
   EXPECT_EQ(rows[1000], "0.999,999,999,9990,99900,,,,");
 }
 
+TEST(ControlProgramThreads, ProgramsWithTheSameNameGetDistinctColumns) {
+  auto dir = scratch("samename");
+  const auto file = dir / "log.csv";
+  {
+    LogWriter writer(file.string());
+    SimulatedClock clock(1e-3, true);
+    Recorder a("arm"), b("arm");
+    for (Recorder* r : {&a, &b}) {
+      r->setClock(clock);
+      r->setLogWriter(&writer);
+      r->setCycleLimit(3);
+      r->start();
+    }
+    clock.resume();
+    a.waitUntilStopped();
+    b.waitUntilStopped();
+  }
+  auto rows = lines(file);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[0], "t,arm.x,arm.q[0],arm.q[1],arm.q[2],arm_2.x,arm_2.q[0],arm_2.q[1],arm_2.q[2]");
+  EXPECT_EQ(rows[3], "0.002,2,2,20,200,2,2,20,200");
+}
+
 TEST(ControlProgramThreads, LogRingOverflowIsCounted) {
   auto dir = scratch("overflow");
   LogWriter writer((dir / "log.csv").string());
