@@ -94,7 +94,13 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   }
 }
 
-DefaultManipulator::~DefaultManipulator() { stopControlLoop(); }
+DefaultManipulator::~DefaultManipulator() {
+  stopControlLoop();
+  if (TrajectoryGenerator* g = generator_.exchange(nullptr)) {
+    disconnectGenerator(*g);
+    g->detach(*this);
+  }
+}
 
 bool DefaultManipulator::inServoThread() const {
   return isRunning() && servoThread_.load(std::memory_order_relaxed) == std::this_thread::get_id();
@@ -175,14 +181,41 @@ void DefaultManipulator::endEffectorForceToJointTorque(const Eigen::Ref<const Ei
 
 void DefaultManipulator::setTrajectoryGenerator(TrajectoryGenerator& generator) {
   generator.attach(*this);
+  connectGenerator(generator);
   TrajectoryGenerator* old = generator_.exchange(&generator);
-  if (old != nullptr && old != &generator) old->detach(*this);
+  if (old != nullptr && old != &generator) {
+    waitUntilNotExecuting(old);
+    disconnectGenerator(*old);
+    old->detach(*this);
+  }
 }
 
 void DefaultManipulator::clearTrajectoryGenerator() {
   holdHere_.store(true);
   TrajectoryGenerator* old = generator_.exchange(nullptr);
-  if (old != nullptr) old->detach(*this);
+  if (old != nullptr) {
+    waitUntilNotExecuting(old);
+    disconnectGenerator(*old);
+    old->detach(*this);
+  }
+}
+
+void DefaultManipulator::releaseTrajectoryGenerator(TrajectoryGenerator& generator) {
+  TrajectoryGenerator* expected = &generator;
+  if (generator_.compare_exchange_strong(expected, nullptr)) holdHere_.store(true);
+  waitUntilNotExecuting(&generator);
+  disconnectGenerator(generator);
+}
+
+void DefaultManipulator::releaseServoControl(ServoControl& control) {
+  ServoControl* expected = &control;
+  servoControl_.compare_exchange_strong(expected, defaultControl_.get());
+  waitUntilNotExecuting(&control);
+}
+
+void DefaultManipulator::waitUntilNotExecuting(const void* object) const {
+  // A cycle runs a control or generator for microseconds; yield until it is done with `object`.
+  while (isRunning() && executing_.load(std::memory_order_acquire) == object) std::this_thread::yield();
 }
 
 TrajectoryGenerator* DefaultManipulator::getTrajectoryGenerator() const { return generator_.load(); }
@@ -240,18 +273,13 @@ void DefaultManipulator::control() {
   const int n = model_->getNumberOfJoints();
 
   // 1. Commands from other threads, then the joints.
-  ServoControl* control = servoControl_.load(std::memory_order_acquire);
-  if (control != activeControl_) {
-    activeControl_ = control;
-    control->activate();
-  }
   const int phase = shutdownPhase_.load(std::memory_order_acquire);
   const bool wantPower = powerRequested_.load(std::memory_order_relaxed) && phase == 0;
   if (wantPower != power_ && phase == 0) {
     power_ = wantPower;
     sim_->setBrakes(!power_);
     hold_ = sim_->getPosition();
-    if (power_) activeControl_->activate();
+    if (power_) activeControl_ = nullptr;  // activate() again below
   }
   Vector<6> wrench = sim_->getExternalWrench();
   wrench_->read(wrench);
@@ -266,8 +294,13 @@ void DefaultManipulator::control() {
   setpoint_.velocity.setZero();
   setpoint_.acceleration.setZero();
   TrajectoryGenerator* generator = generator_.load(std::memory_order_acquire);
-  if (generator != nullptr && power_ && !zeroG && phase == 0 && generator->getCurrentSetpoint(t, setpoint_)) {
-    hold_ = setpoint_.position;
+  if (generator != nullptr && power_ && !zeroG && phase == 0) {
+    executing_.store(generator, std::memory_order_seq_cst);
+    // Re-check: a generator being released is not called any more.
+    if (generator_.load(std::memory_order_seq_cst) == generator && generator->getCurrentSetpoint(t, setpoint_)) {
+      hold_ = setpoint_.position;
+    }
+    executing_.store(nullptr, std::memory_order_release);
   }
 
   // 3. Servo control.
@@ -277,7 +310,19 @@ void DefaultManipulator::control() {
     // Damped hold: velocity damping with the default derivative gains, plus gravity.
     tau_ = -(defaultControl_->getKd().cwiseProduct(qd_));
   } else if (!zeroG) {
-    activeControl_->calculate();
+    ServoControl* control = servoControl_.load(std::memory_order_acquire);
+    executing_.store(control, std::memory_order_seq_cst);
+    if (servoControl_.load(std::memory_order_seq_cst) != control) {
+      // Released between the two loads: take the new one (the default control on a release).
+      control = servoControl_.load(std::memory_order_acquire);
+      executing_.store(control, std::memory_order_seq_cst);
+    }
+    if (control != activeControl_) {
+      activeControl_ = control;
+      control->activate();
+    }
+    control->calculate();
+    executing_.store(nullptr, std::memory_order_release);
   }
   if (gravityOn || zeroG || phase != 0) {
     gravityTorque(*model_, *data_, q_, gravity_);

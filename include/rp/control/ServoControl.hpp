@@ -31,11 +31,15 @@ class ServoControl : public FunctionalObject {
   /// Creates a servo control not yet attached to a manipulator.
   /// @param[in] name  object name; empty for an automatic name
   explicit ServoControl(const std::string& name = "") : FunctionalObject(name) {}
+  /// Detaches from the manipulator: if it is the manipulator's servo control, the manipulator
+  /// switches back to its default control first and this returns once no servo cycle uses it.
+  ~ServoControl() override;
 
-  /// Computes the control output of the current cycle.
+  /// Computes the control output of the current cycle. Derived classes implement it; the default
+  /// outputs nothing (zero torque, plus gravity if compensation is on).
   /// @pre attached to a manipulator (`d_manipulator` set)
   /// Real-time safe: must be.
-  virtual void calculate() = 0;
+  virtual void calculate() {}
 
   /// Called in the servo thread in the first cycle this control is active (after a switch or at
   /// start): reset integrators here for a bumpless transfer. The default does nothing.
@@ -55,6 +59,9 @@ class ServoControl : public FunctionalObject {
  protected:
   /// The manipulator this control drives (the paper's name, as Figure 22 uses it).
   Manipulator* d_manipulator = nullptr;
+
+ private:
+  friend class Manipulator;  // clears d_manipulator when the manipulator goes first
 };
 
 }  // namespace rp

@@ -83,6 +83,8 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   bool isZeroGravityModeOn() const override { return zeroGravity_.load(); }
 
   void applyExternalWrench(const Vector<6>& wrench) override;
+  void releaseServoControl(ServoControl& control) override;
+  void releaseTrajectoryGenerator(TrajectoryGenerator& generator) override;
 
   /// Starts the damped hold and then switches the power off.
   void startShutdown() override;
@@ -113,6 +115,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   struct WrenchBox;
 
   bool inServoThread() const;
+  void waitUntilNotExecuting(const void* object) const;
   void checkLimits();
   void violation(const char* what, int joint, double value, double limit, const char* unit);
   void publish();
@@ -126,6 +129,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   std::atomic<ServoControl*> servoControl_{nullptr};
   ServoControl* activeControl_ = nullptr;
   std::atomic<TrajectoryGenerator*> generator_{nullptr};
+  std::atomic<const void*> executing_{nullptr};  // the control or generator a cycle is running
   std::atomic<bool> powerRequested_{true};
   std::atomic<bool> gravityCompensation_{true};
   std::atomic<bool> zeroGravity_{false};

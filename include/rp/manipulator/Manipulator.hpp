@@ -29,7 +29,8 @@ class Manipulator : public PhysicalObject {
   /// Creates the manipulator.
   /// @param[in] name  object name; empty for an automatic name
   explicit Manipulator(const std::string& name = "") : PhysicalObject(name) {}
-  ~Manipulator() override = default;
+  /// Disconnects the trajectory generator and the servo controls that refer to this manipulator.
+  ~Manipulator() override;
 
   /// The kinematic and dynamic model. Real-time safe: yes.
   virtual const ManipulatorModel& getModel() const = 0;
@@ -113,6 +114,16 @@ class Manipulator : public PhysicalObject {
   virtual bool isZeroGravityModeOn() const = 0;
   /// @}
 
+  /// Stops using `control` (its destructor calls this): switches to the default servo control if
+  /// `control` is in use and returns once no servo cycle runs it. Real-time safe: no.
+  /// @param[in] control  a servo control about to be destroyed
+  virtual void releaseServoControl(ServoControl& control) = 0;
+  /// Stops using `generator` (its destructor calls this): holds the current position and returns
+  /// once no servo cycle runs it. Real-time safe: no.
+  /// @param[in] generator  a trajectory generator about to be destroyed
+  virtual void releaseTrajectoryGenerator(TrajectoryGenerator& generator) = 0;
+  /// @}
+
   /// @name Simulation
   /// @{
   /// In simulation mode: sets the wrench the environment applies to the end-effector, in world
@@ -122,6 +133,14 @@ class Manipulator : public PhysicalObject {
   /// Removes the external wrench.
   void clearExternalWrench() { applyExternalWrench(Vector<6>()); }
   /// @}
+
+ protected:
+  /// Records that this manipulator calls `generator` (derived classes call it when connecting).
+  /// @param[in] generator  the generator
+  void connectGenerator(TrajectoryGenerator& generator);
+  /// Records that this manipulator no longer calls `generator`.
+  /// @param[in] generator  the generator
+  void disconnectGenerator(TrajectoryGenerator& generator);
 };
 
 }  // namespace rp

@@ -2,7 +2,9 @@
 /// @file
 /// The interface of trajectory generators (paper section 3.3, Figure 8).
 
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include "rp/core/PhysicalObject.hpp"
 #include "rp/trajectory/Setpoint.hpp"
@@ -23,6 +25,9 @@ class TrajectoryGenerator : public FunctionalObject {
   /// Creates a generator.
   /// @param[in] name  object name; empty for an automatic name
   explicit TrajectoryGenerator(const std::string& name = "") : FunctionalObject(name) {}
+  /// Disconnects from every manipulator it drives (each then holds its position); returns once no
+  /// servo cycle uses the generator.
+  ~TrajectoryGenerator() override;
 
   /// The setpoint at servo-clock time `time`.
   /// @param[in]     time      the calling servo loop's clock time [s]
@@ -30,7 +35,11 @@ class TrajectoryGenerator : public FunctionalObject {
   ///                          true return the generator's setpoint
   /// @return true if the generator produced a setpoint, false if the manipulator should hold
   /// Real-time safe: must be (no allocation, locking or blocking).
-  virtual bool getCurrentSetpoint(double time, Setpoint& setpoint) = 0;
+  virtual bool getCurrentSetpoint(double time, Setpoint& setpoint) {
+    (void)time;
+    (void)setpoint;
+    return false;
+  }
 
   /// Called (in the caller's thread) when `manipulator` connects to this generator.
   /// @param[in] manipulator  the manipulator that will call getCurrentSetpoint()
@@ -41,6 +50,14 @@ class TrajectoryGenerator : public FunctionalObject {
   /// @param[in] manipulator  the manipulator that no longer calls getCurrentSetpoint()
   /// Real-time safe: no.
   virtual void detach(Manipulator& manipulator) { (void)manipulator; }
+
+  /// The manipulators connected to this generator. Real-time safe: no.
+  std::vector<Manipulator*> getManipulators() const;
+
+ private:
+  friend class Manipulator;
+  mutable std::mutex manipulatorsMutex_;
+  std::vector<Manipulator*> manipulators_;
 };
 
 }  // namespace rp

@@ -1,0 +1,112 @@
+// Virtual walls: the paper's Figure 22, a custom servo control.
+//
+// A virtual wall is the plane w . (x, 1) = 0 with w = (n, d0): the end-effector is outside the
+// wall where w . x > 0 and inside where it is < 0, and inside it feels a spring force along the
+// normal n that pushes it back out. Gravity compensation is on, so outside the wall the arm floats
+// and can be pushed around.
+//
+// Run: build/bin/virtual_walls [--duration S] [--push FX,FY,FZ]
+//   --duration S   stop after S seconds of robot time (default: run until Ctrl-C)
+//   --push F       in simulation, push the end-effector with the constant force F [N] (world
+//                  frame), to feel the wall without a GUI; the final position is printed at exit
+//
+// Changes from the paper's Figure 22:
+// 1. `int main(int argc, char* argv[])`; the loop at the end waits for Ctrl-C or --duration (the
+//    paper's main returned at once, which would destroy the robot) and handles --push.
+// 2. `getJointPositon` is spelled `getJointPosition`.
+// 3. The size bug: the force uses the first three wall coefficients, the normal n, instead of
+//    the 4-vector (`d_wallCoefficients.getSubMatrix<3, 1>(1, 1)`).
+// 4. The sign: the paper's `distance * n * kf` points into the wall (distance < 0 inside); the
+//    force here is `-distance * n * kf`, which pushes the end-effector back out.
+// 5. The numbers: the paper's wall (0, 0, -1, 3) lies 3 m up, out of the Puma's reach, and
+//    kf = 0.01 N/m is too soft to feel. Here the wall is the plane x = 0.4 m, (-1, 0, 0, 0.4),
+//    with kf = 2000 N/m (a 20 N push goes 1 cm into the wall).
+// 6. `override` on calculate() and `std::` where needed; the class is unchanged otherwise.
+#include "RoboticPlatform.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+#include <thread>
+
+// ----- Create a new servo control class -----
+
+template <int numJoints>
+class VirtualWallServoControl : public ServoControl  // (1)
+{
+ public:
+  void calculate() override {
+    // What is the distance of the end-effector to the wall?
+    Transform t = d_manipulator->getEndEffectorPosition();
+    double distance = dotProduct(d_wallCoefficients, t.getColumn(4));
+    if (distance > 0)  // No control output
+      return;
+
+    // We are inside the wall. Generate reacting force
+    Vector<3> force = -distance * d_wallCoefficients.getSubMatrix<3, 1>(1, 1) * d_kf;
+
+    // Convert to joint torque
+    Vector<numJoints> pos = d_manipulator->getJointPosition();
+    Vector<numJoints> torque;
+    d_manipulator->endEffectorForceToJointTorque(pos, force, torque);
+
+    // Do the control output
+    d_manipulator->setControlOutput(torque);
+  }
+
+  Vector<4> d_wallCoefficients;
+  double d_kf;
+};
+
+// ----- Use the virtual walls servo control -----
+
+int main(int argc, char* argv[]) {
+  RoboticPlatform::init(argc, argv,
+                        "  --duration S     stop after S seconds of robot time\n"
+                        "  --push FX,FY,FZ  push the simulated end-effector with a constant force [N]\n");
+
+  double duration = -1;
+  Vector<6> push;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--duration" && i + 1 < argc) {
+      duration = std::atof(argv[++i]);
+    } else if (a == "--push" && i + 1 < argc) {
+      if (std::sscanf(argv[++i], "%lf,%lf,%lf", &push(0), &push(1), &push(2)) != 3) {
+        std::cerr << "virtual_walls: --push needs FX,FY,FZ" << std::endl;
+        return 2;
+      }
+    } else {
+      std::cerr << "virtual_walls: unknown argument '" << a << "' (see --help)" << std::endl;
+      return 2;
+    }
+  }
+
+  Puma560 puma;  // Create the robot object
+
+  // Virtual wall control for 6 joints
+  VirtualWallServoControl<6> wallControl;  // (2)
+  wallControl.d_kf = 2000;
+  wallControl.d_wallCoefficients = -1, 0, 0, 0.4;
+
+  puma.setGravityCompensationOn();  // (3)
+  puma.setServoControl(wallControl);
+
+  if (push.squaredNorm() > 0) puma.applyExternalWrench(push);
+  // Run until Ctrl-C (a system shutdown) or for `duration` seconds of robot time: whole servo
+  // cycles, so the simulated clock (-simclock) stops at the same point as the real one.
+  const auto cycles = static_cast<std::uint64_t>(duration / puma.getPeriod());
+  while (!ObjectManager::isShutdownRequested() && (duration < 0 || cycles > 0)) {
+    if (duration < 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    } else {
+      puma.waitForCycles(cycles);
+      break;
+    }
+  }
+  const Transform t = puma.getEndEffectorTransform();
+  std::cout << "final end-effector position: " << t(0, 3) << " " << t(1, 3) << " " << t(2, 3) << std::endl;
+  return puma.getErrorCode() == 0 ? 0 : 1;
+}

@@ -1,0 +1,16 @@
+# Runs PROGRAM with ARGS, reads its "final end-effector position: x y z" line and checks that
+# coordinate AXIS (0, 1, 2) lies in [MIN, MAX] and that the program exited 0.
+execute_process(COMMAND ${PROGRAM} ${ARGS} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 100)
+message("${out}${err}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "exit status ${rc}")
+endif()
+if(NOT out MATCHES "final end-effector position: ([-0-9.e]+) ([-0-9.e]+) ([-0-9.e]+)")
+  message(FATAL_ERROR "no final position in the output")
+endif()
+math(EXPR group "${AXIS} + 1")
+set(value ${CMAKE_MATCH_${group}})
+if(value LESS MIN OR value GREATER MAX)
+  message(FATAL_ERROR "coordinate ${AXIS} = ${value} is outside [${MIN}, ${MAX}]")
+endif()
+message("coordinate ${AXIS} = ${value} within [${MIN}, ${MAX}]")
