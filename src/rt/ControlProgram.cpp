@@ -243,7 +243,8 @@ struct ControlProgram::Impl {
     setUpRealTime();
     const auto period = static_cast<std::int64_t>(std::llround(1e9 / rate));
     const std::int64_t epoch = RealClock::instance().epochNanoseconds();
-    std::int64_t deadline = internal::monotonicNanoseconds();
+    // The first deadline is one period away (as in cyclictest), so every wake-up is a real one.
+    std::int64_t deadline = internal::monotonicNanoseconds() + period;
     std::uint64_t k = 0;
     while (!stopRequested.load(std::memory_order_relaxed)) {
       // Sleep until the absolute deadline, in slices so that stop() is never kept waiting long.
