@@ -9,4 +9,7 @@
 #include "rp/manipulator/ManipulatorSimulation.hpp"
 #include "rp/manipulator/Puma560.hpp"
 #include "rp/manipulator/WAM.hpp"
+#include "rp/trajectory/DefaultTrajectoryGenerator.hpp"
+#include "rp/trajectory/JerkLimitedProfile.hpp"
+#include "rp/trajectory/QueueTrajectoryGenerator.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"

@@ -3,6 +3,7 @@
 /// Manipulator models and their kinematics and dynamics algorithms.
 
 #include "rp/model/Dynamics.hpp"
+#include "rp/model/InverseKinematics.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/ManipulatorData.hpp"
 #include "rp/model/ManipulatorModel.hpp"

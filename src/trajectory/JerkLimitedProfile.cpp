@@ -1,0 +1,95 @@
+// Time-optimal jerk-limited rest-to-rest profile (rp/trajectory/JerkLimitedProfile.hpp).
+#include "rp/trajectory/JerkLimitedProfile.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace rp {
+
+JerkLimitedProfile::JerkLimitedProfile(double distance, double vmax, double amax, double jmax)
+    : distance_(distance), jerk_(jmax) {
+  if (!(distance >= 0) || !std::isfinite(distance)) {
+    throw std::invalid_argument("JerkLimitedProfile: distance must be finite and >= 0, got " + std::to_string(distance));
+  }
+  if (!(vmax > 0) || !(amax > 0) || !(jmax > 0)) {
+    throw std::invalid_argument("JerkLimitedProfile: velocity, acceleration and jerk limits must be positive");
+  }
+  if (distance == 0) return;
+  const double D = distance, v = vmax, a = amax, j = jmax;
+  // Case 1: the velocity limit is reached.
+  double tj, ta;
+  if (v * j >= a * a) {
+    tj = a / j;
+    ta = tj + v / a;
+  } else {
+    tj = std::sqrt(v / j);
+    ta = 2 * tj;
+  }
+  double tv = D / v - ta;
+  if (tv < 0) {
+    tv = 0;
+    if (D >= 2 * a * a * a / (j * j)) {
+      // Case 2: the acceleration limit is reached, the velocity limit is not.
+      tj = a / j;
+      ta = 0.5 * (tj + std::sqrt(tj * tj + 4 * D / a));
+    } else {
+      // Case 3: neither limit is reached.
+      tj = std::cbrt(D / (2 * j));
+      ta = 2 * tj;
+    }
+  }
+  tj_ = tj;
+  ta_ = ta;
+  tv_ = tv;
+  ap_ = j * tj;
+  vp_ = ap_ * (ta - tj);
+}
+
+// The acceleration phase from rest: jerk +j for tj, constant acceleration, jerk -j for tj.
+ProfileState JerkLimitedProfile::accelerationPhase(double t) const {
+  const double j = jerk_, tj = tj_, ta = ta_, ap = ap_;
+  ProfileState s;
+  if (t <= tj) {
+    s.acceleration = j * t;
+    s.velocity = 0.5 * j * t * t;
+    s.position = j * t * t * t / 6;
+  } else if (t <= ta - tj) {
+    const double u = t - tj;
+    const double v1 = 0.5 * j * tj * tj, p1 = j * tj * tj * tj / 6;
+    s.acceleration = ap;
+    s.velocity = v1 + ap * u;
+    s.position = p1 + v1 * u + 0.5 * ap * u * u;
+  } else {
+    // Mirror of the start: reaching vp with zero acceleration at ta.
+    const double r = ta - t;  // time left in the phase
+    const double halfDistance = 0.5 * vp_ * ta;
+    s.acceleration = j * r;
+    s.velocity = vp_ - 0.5 * j * r * r;
+    s.position = halfDistance - vp_ * r + j * r * r * r / 6;
+  }
+  return s;
+}
+
+ProfileState JerkLimitedProfile::evaluate(double t) const {
+  const double T = getDuration();
+  if (distance_ == 0) return ProfileState{};
+  t = std::clamp(t, 0.0, T);
+  if (t <= ta_) return accelerationPhase(t);
+  if (t <= ta_ + tv_) {
+    ProfileState s;
+    s.velocity = vp_;
+    s.position = 0.5 * vp_ * ta_ + vp_ * (t - ta_);
+    return s;
+  }
+  // Deceleration: the acceleration phase played backwards from the end.
+  const ProfileState m = accelerationPhase(T - t);
+  ProfileState s;
+  s.position = distance_ - m.position;
+  s.velocity = m.velocity;
+  s.acceleration = -m.acceleration;
+  return s;
+}
+
+}  // namespace rp

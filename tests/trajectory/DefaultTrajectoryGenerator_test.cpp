@@ -1,0 +1,118 @@
+// DefaultTrajectoryGenerator driving simulated arms on the simulated clock.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "AllocationCounter.hpp"
+#include "rp/RoboticPlatform.hpp"
+
+namespace rp {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180;
+
+class TrajectoryTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    RoboticPlatform::setConfiguration(Configuration());
+    RoboticPlatform::setSimulationModeOn();
+    RoboticPlatform::useSimulatedClock();
+    ObjectManager::resetShutdown();
+  }
+};
+
+TEST_F(TrajectoryTest, JointMovesInDegreesReachTheirTargets) {
+  Puma560 puma;
+  DefaultTrajectoryGenerator<6> tragen;
+  puma.setTrajectoryGenerator(tragen);
+  Vector<6> target;
+  target = 0, 45, -90, 0, 0, 0;
+  tragen.move(target);
+  target = -50, 0, -70, 50, -80, 0;
+  tragen.move(target);
+  EXPECT_GE(tragen.getSegmentsLeft(), 1);
+  tragen.stop(0.5);
+  EXPECT_TRUE(tragen.isDone());
+  const JointVector q = puma.getJointPosition();
+  // Within the PID's Coulomb-friction dead band after half a second at rest (< 0.01 rad).
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(q(i), target(i) * kDeg, 0.01) << "joint " << i + 1;
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(TrajectoryTest, TargetsOutsideTheLimitsAreRefusedBeforeTheArmMoves) {
+  Puma560 puma;
+  DefaultTrajectoryGenerator<6> tragen;
+  puma.setTrajectoryGenerator(tragen);
+  Vector<6> target;
+  target = 0, 120, 0, 0, 0, 0;  // joint 2 limit 110 degrees
+  try {
+    tragen.move(target);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("target joint 2 = 120"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(tragen.isDone());
+  Vector<5> five;
+  EXPECT_THROW(tragen.move(five), std::invalid_argument);
+  EXPECT_THROW(tragen.moveTo(translation(3, 0, 0)), std::invalid_argument);  // out of reach
+}
+
+TEST_F(TrajectoryTest, CartesianTargetIsReached) {
+  Puma560 puma;
+  DefaultTrajectoryGenerator<6> tragen;
+  puma.setTrajectoryGenerator(tragen);
+  const Transform goal = translation(0.5, 0.2, 0.3) * xRotation(M_PI);
+  tragen.moveTo(goal);
+  tragen.stop(1);
+  const Transform reached = puma.getEndEffectorTransform();
+  EXPECT_LT((getPosition(reached) - getPosition(goal)).norm(), 0.005);  // 5 mm: friction dead band
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(TrajectoryTest, AFixedSizeGeneratorRefusesAnotherArm) {
+  WAM wam("", 7);
+  DefaultTrajectoryGenerator<6> six;
+  EXPECT_THROW(wam.setTrajectoryGenerator(six), std::invalid_argument);
+  DefaultTrajectoryGenerator any;
+  wam.setTrajectoryGenerator(any);
+  JointVector home = wam.getModel().getHomePosition();
+  home(0) += 0.2;
+  any.moveRadians(home);
+  any.stop(0.2);
+  EXPECT_NEAR(wam.getJointPosition()(0), home(0), 0.01);
+}
+
+TEST_F(TrajectoryTest, SetpointEvaluationDoesNotAllocateAndStaysWithinLimits) {
+  Puma560 puma;
+  DefaultTrajectoryGenerator<6> tragen;
+  Setpoint sp;
+  sp.position = sp.velocity = sp.acceleration = JointVector(6);
+  SimulatedClock& clock = dynamic_cast<SimulatedClock&>(RoboticPlatform::getDefaultClock());
+  clock.pause();  // evaluate here, not in the servo thread
+  puma.clearTrajectoryGenerator();
+  puma.setTrajectoryGenerator(tragen);
+  Vector<6> target;
+  target = 30, 60, -60, 20, 20, 20;
+  tragen.move(target);
+  const ManipulatorModel& model = puma.getModel();
+  double t0 = 1000;
+  test::AllocationGuard guard;
+  double worstVelocityRatio = 0;
+  for (int i = 0; i < 20000; ++i) {
+    ASSERT_TRUE(tragen.getCurrentSetpoint(t0 + i * 1e-3, sp));
+    for (int k = 0; k < 6; ++k) {
+      worstVelocityRatio = std::max(worstVelocityRatio, std::abs(sp.velocity(k)) / model.getVelocityLimit()(k));
+      ASSERT_LE(std::abs(sp.acceleration(k)), 0.8 * model.getAccelerationLimit()(k) * (1 + 1e-9));
+    }
+  }
+  EXPECT_EQ(guard.count(), 0u);
+  EXPECT_LE(worstVelocityRatio, 0.8 * (1 + 1e-9)) << "planned with 80 % of the limits";
+  EXPECT_TRUE(tragen.isDone());
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(sp.position(k), target(k) * kDeg, 1e-12);
+  puma.clearTrajectoryGenerator();
+  clock.resume();
+}
+
+}  // namespace
+}  // namespace rp
