@@ -41,6 +41,7 @@ class Manipulator : public PhysicalObject {
 
   /// @name Joint state
   /// @{
+
   /// Joint positions (n x 1) [rad]. Real-time safe: yes.
   virtual JointVector getJointPosition() const = 0;
   /// Joint velocities (n x 1) [rad/s]. Real-time safe: yes.
@@ -58,6 +59,7 @@ class Manipulator : public PhysicalObject {
 
   /// @name Arm power
   /// @{
+
   /// Switches the arm power on (motors enabled, brakes released); the arm holds its position.
   virtual void enableArmPower() = 0;
   /// Switches the arm power off (brakes engaged, no torque).
@@ -68,6 +70,7 @@ class Manipulator : public PhysicalObject {
 
   /// @name Kinematics
   /// @{
+
   /// Pose of the end-effector in the world for the current joint positions [m].
   /// Real-time safe: yes in the servo thread.
   virtual Transform getEndEffectorTransform() const = 0;
@@ -87,6 +90,7 @@ class Manipulator : public PhysicalObject {
 
   /// @name Servo control and trajectory generation
   /// @{
+
   /// Connects a trajectory generator; the manipulator follows its setpoints from the next cycle.
   /// @param[in] generator  the generator (must outlive the connection)
   virtual void setTrajectoryGenerator(TrajectoryGenerator& generator) = 0;
@@ -112,8 +116,6 @@ class Manipulator : public PhysicalObject {
   virtual void setZeroGravityModeOff() = 0;
   /// Whether zero-gravity mode is on. Real-time safe: yes.
   virtual bool isZeroGravityModeOn() const = 0;
-  /// @}
-
   /// Stops using `control` (its destructor calls this): switches to the default servo control if
   /// `control` is in use and returns once no servo cycle runs it. Real-time safe: no.
   /// @param[in] control  a servo control about to be destroyed
@@ -126,6 +128,7 @@ class Manipulator : public PhysicalObject {
 
   /// @name Simulation
   /// @{
+
   /// In simulation mode: sets the wrench the environment applies to the end-effector, in world
   /// coordinates (force [N], moment [N m] about the end-effector origin), until changed.
   /// @param[in] wrench  (6 x 1); zero for none
