@@ -176,8 +176,9 @@ struct ControlProgram::Impl {
       const std::uint64_t s1 = p->seq.load(std::memory_order_acquire);
       if (s1 & 1) continue;  // a writer is busy; try next cycle
       p->dirty.store(false, std::memory_order_relaxed);
-      for (std::size_t i = 0; i < p->info.size; ++i) p->target[i] = p->pending[i].load(std::memory_order_relaxed);
-      std::atomic_thread_fence(std::memory_order_acquire);
+      // Acquire loads keep the second sequence read after the element reads (no fence: GCC
+      // rejects atomic_thread_fence under ThreadSanitizer).
+      for (std::size_t i = 0; i < p->info.size; ++i) p->target[i] = p->pending[i].load(std::memory_order_acquire);
       if (p->seq.load(std::memory_order_relaxed) != s1) p->dirty.store(true, std::memory_order_relaxed);
     }
   }
