@@ -29,7 +29,8 @@ void rnea(const ManipulatorModel& model, ManipulatorData& data, const JointVecto
     const auto k = static_cast<std::size_t>(i);
     const LinkParameters& l = model.getLink(i);
     const double theta = q(i) + l.offset;
-    const double ct = std::cos(theta), st = std::sin(theta), ca = std::cos(l.alpha), sa = std::sin(l.alpha);
+    const double ct = std::cos(theta), st = std::sin(theta);
+    const double ca = model.getCosAlpha()(i), sa = model.getSinAlpha()(i);
     Matrix<3, 3>& R = data.R[k];
     R(0, 0) = ct;
     R(0, 1) = -st * ca;

@@ -5,41 +5,29 @@
 
 namespace rp {
 
-namespace {
-
-// A_i = Rz(theta) Tz(d) Tx(a) Rx(alpha), written out.
-void dhTransform(const LinkParameters& l, double q, Transform& A) {
-  const double theta = q + l.offset;
-  const double ct = std::cos(theta), st = std::sin(theta), ca = std::cos(l.alpha), sa = std::sin(l.alpha);
-  A(0, 0) = ct;
-  A(0, 1) = -st * ca;
-  A(0, 2) = st * sa;
-  A(0, 3) = l.a * ct;
-  A(1, 0) = st;
-  A(1, 1) = ct * ca;
-  A(1, 2) = -ct * sa;
-  A(1, 3) = l.a * st;
-  A(2, 0) = 0;
-  A(2, 1) = sa;
-  A(2, 2) = ca;
-  A(2, 3) = l.d;
-  A(3, 0) = 0;
-  A(3, 1) = 0;
-  A(3, 2) = 0;
-  A(3, 3) = 1;
-}
-
-}  // namespace
 
 const Transform& forwardKinematics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q) {
-  Transform A;
+  // T_i = T_{i-1} A_i on the affine part only (the last row of a transform is constant).
   const Transform* previous = &model.getBaseTransform();
   for (int i = 0; i < data.n; ++i) {
-    dhTransform(model.getLink(i), q(i), A);
-    data.linkTransforms[static_cast<std::size_t>(i)] = *previous * A;
-    previous = &data.linkTransforms[static_cast<std::size_t>(i)];
+    const LinkParameters& l = model.getLink(i);
+    const double theta = q(i) + l.offset;
+    const double ct = std::cos(theta), st = std::sin(theta);
+    const double ca = model.getCosAlpha()(i), sa = model.getSinAlpha()(i);
+    Eigen::Matrix<double, 3, 4> A;
+    A << ct, -st * ca, st * sa, l.a * ct,  //
+        st, ct * ca, -ct * sa, l.a * st,   //
+        0, sa, ca, l.d;
+    Transform& T = data.linkTransforms[static_cast<std::size_t>(i)];
+    T.topRows<3>().noalias() = previous->topLeftCorner<3, 3>() * A;
+    T.topRightCorner<3, 1>() += previous->topRightCorner<3, 1>();
+    T.row(3) << 0, 0, 0, 1;
+    previous = &T;
   }
-  data.endEffector = *previous * model.getToolTransform();
+  const Transform& tool = model.getToolTransform();
+  data.endEffector.topRows<3>().noalias() = previous->topLeftCorner<3, 3>() * tool.topRows<3>();
+  data.endEffector.topRightCorner<3, 1>() += previous->topRightCorner<3, 1>();
+  data.endEffector.row(3) << 0, 0, 0, 1;
   return data.endEffector;
 }
 

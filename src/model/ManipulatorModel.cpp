@@ -22,7 +22,7 @@ ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters>
     throw std::invalid_argument("ManipulatorModel '" + name_ + "': " + std::to_string(n) +
                                 " links; a model has 1 to " + std::to_string(kMaxJoints));
   }
-  for (JointVector* v : {&qmin_, &qmax_, &vmax_, &amax_, &jmax_, &taumax_, &armature_, &home_}) v->setZero(n);
+  for (JointVector* v : {&qmin_, &qmax_, &vmax_, &amax_, &jmax_, &taumax_, &armature_, &home_, &cosAlpha_, &sinAlpha_}) v->setZero(n);
   for (int i = 0; i < n; ++i) {
     const LinkParameters& l = links_[static_cast<std::size_t>(i)];
     const std::string joint = "ManipulatorModel '" + name_ + "' joint " + std::to_string(i + 1) + ": ";
@@ -39,6 +39,8 @@ ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters>
     taumax_(i) = l.torqueLimit;
     armature_(i) = l.gearRatio * l.gearRatio * l.motorInertia;
     home_(i) = std::clamp(0.0, l.positionMin, l.positionMax);
+    cosAlpha_(i) = std::cos(l.alpha);
+    sinAlpha_(i) = std::sin(l.alpha);
   }
 }
 

@@ -119,6 +119,11 @@ class ManipulatorModel {
   /// Whether `q` lies within the joint limits (inclusive). Real-time safe: yes.
   bool isWithinLimits(const JointVector& q) const;
 
+  /// \f$\cos\alpha_i\f$ of every link (precomputed for the algorithms). Real-time safe: yes.
+  const JointVector& getCosAlpha() const { return cosAlpha_; }
+  /// \f$\sin\alpha_i\f$ of every link (precomputed for the algorithms). Real-time safe: yes.
+  const JointVector& getSinAlpha() const { return sinAlpha_; }
+
   /// A good resting configuration (the model's home or ready pose) [rad]. Real-time safe: yes.
   const JointVector& getHomePosition() const { return home_; }
 
@@ -133,7 +138,7 @@ class ManipulatorModel {
   Transform base_, tool_;
   Vector<3> gravity_;
   DHConvention convention_;
-  JointVector qmin_, qmax_, vmax_, amax_, jmax_, taumax_, armature_, home_;
+  JointVector qmin_, qmax_, vmax_, amax_, jmax_, taumax_, armature_, home_, cosAlpha_, sinAlpha_;
 };
 
 }  // namespace rp

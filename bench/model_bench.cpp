@@ -1,0 +1,196 @@
+// Kinematics and dynamics of the Puma 560 and the WAM 7, ours next to Orocos KDL's solvers
+// (ChainFkSolverPos_recursive, ChainJntToJacSolver, ChainIdSolver_RNE, ChainDynParam::JntToMass,
+// ChainFdSolver_RNE, ChainIkSolverPos_LMA), on the same 64 seeded random configurations.
+#include <benchmark/benchmark.h>
+
+#include <kdl/chaindynparam.hpp>
+#include <kdl/chainfdsolver_recursive_newton_euler.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/chainiksolverpos_lma.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
+
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "../tests/model/KdlChain.hpp"
+#include "rp/model/Model.hpp"
+
+namespace {
+
+using namespace rp;
+
+struct Robot {
+  std::unique_ptr<ManipulatorModel> model;
+  std::unique_ptr<ManipulatorData> data;
+  KDL::Chain chain;
+  std::vector<JointVector> q, qd, qdd;
+  std::vector<KDL::JntArray> kq, kqd, kqdd;
+  std::vector<Transform> poses;
+
+  explicit Robot(std::unique_ptr<ManipulatorModel> m) : model(std::move(m)) {
+    data = std::make_unique<ManipulatorData>(*model);
+    chain = test::kdlChain(*model);
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    const int n = model->getNumberOfJoints();
+    for (int k = 0; k < 64; ++k) {
+      JointVector a(n), b(n), c(n);
+      for (int i = 0; i < n; ++i) {
+        a(i) = model->getPositionMin()(i) + u(rng) * (model->getPositionMax()(i) - model->getPositionMin()(i));
+        b(i) = 2 * u(rng) - 1;
+        c(i) = 4 * u(rng) - 2;
+      }
+      q.push_back(a);
+      qd.push_back(b);
+      qdd.push_back(c);
+      kq.push_back(test::kdlJoints(a));
+      kqd.push_back(test::kdlJoints(b));
+      kqdd.push_back(test::kdlJoints(c));
+      poses.push_back(forwardKinematics(*model, *data, a));
+    }
+  }
+};
+
+Robot& puma() {
+  static Robot r(std::make_unique<Puma560Model>());
+  return r;
+}
+Robot& wam7() {
+  static Robot r(std::make_unique<WAM7Model>());
+  return r;
+}
+Robot& robot(const benchmark::State& s) { return s.range(0) == 6 ? puma() : wam7(); }
+
+void ForwardKinematics_rp(benchmark::State& s) {
+  Robot& r = robot(s);
+  std::size_t k = 0;
+  for (auto _ : s) benchmark::DoNotOptimize(forwardKinematics(*r.model, *r.data, r.q[k++ & 63]));
+}
+void ForwardKinematics_KDL(benchmark::State& s) {
+  Robot& r = robot(s);
+  KDL::ChainFkSolverPos_recursive fk(r.chain);
+  KDL::Frame f;
+  std::size_t k = 0;
+  for (auto _ : s) {
+    fk.JntToCart(r.kq[k++ & 63], f);
+    benchmark::DoNotOptimize(f);
+  }
+}
+void Jacobian_rp(benchmark::State& s) {
+  Robot& r = robot(s);
+  std::size_t k = 0;
+  for (auto _ : s) benchmark::DoNotOptimize(jacobian(*r.model, *r.data, r.q[k++ & 63]).data());
+}
+void Jacobian_KDL(benchmark::State& s) {
+  Robot& r = robot(s);
+  KDL::ChainJntToJacSolver jac(r.chain);
+  KDL::Jacobian J(r.chain.getNrOfJoints());
+  std::size_t k = 0;
+  for (auto _ : s) {
+    jac.JntToJac(r.kq[k++ & 63], J);
+    benchmark::DoNotOptimize(J.data.data());
+  }
+}
+void InverseDynamics_rp(benchmark::State& s) {
+  Robot& r = robot(s);
+  std::size_t k = 0;
+  for (auto _ : s) {
+    const std::size_t i = k++ & 63;
+    benchmark::DoNotOptimize(inverseDynamics(*r.model, *r.data, r.q[i], r.qd[i], r.qdd[i]).data());
+  }
+}
+void InverseDynamics_KDL(benchmark::State& s) {
+  Robot& r = robot(s);
+  KDL::ChainIdSolver_RNE id(r.chain, KDL::Vector(0, 0, -9.81));
+  KDL::JntArray tau(r.chain.getNrOfJoints());
+  KDL::Wrenches w(r.chain.getNrOfSegments(), KDL::Wrench::Zero());
+  std::size_t k = 0;
+  for (auto _ : s) {
+    const std::size_t i = k++ & 63;
+    id.CartToJnt(r.kq[i], r.kqd[i], r.kqdd[i], w, tau);
+    benchmark::DoNotOptimize(tau.data.data());
+  }
+}
+void MassMatrix_rp(benchmark::State& s) {
+  Robot& r = robot(s);
+  std::size_t k = 0;
+  for (auto _ : s) benchmark::DoNotOptimize(massMatrix(*r.model, *r.data, r.q[k++ & 63]).data());
+}
+void MassMatrix_KDL(benchmark::State& s) {
+  Robot& r = robot(s);
+  KDL::ChainDynParam dyn(r.chain, KDL::Vector(0, 0, -9.81));
+  KDL::JntSpaceInertiaMatrix M(r.chain.getNrOfJoints());
+  std::size_t k = 0;
+  for (auto _ : s) {
+    dyn.JntToMass(r.kq[k++ & 63], M);
+    benchmark::DoNotOptimize(M.data.data());
+  }
+}
+void ForwardDynamics_rp(benchmark::State& s) {
+  Robot& r = robot(s);
+  std::size_t k = 0;
+  for (auto _ : s) {
+    const std::size_t i = k++ & 63;
+    benchmark::DoNotOptimize(forwardDynamics(*r.model, *r.data, r.q[i], r.qd[i], r.qdd[i]).data());
+  }
+}
+void ForwardDynamics_KDL(benchmark::State& s) {
+  Robot& r = robot(s);
+  KDL::ChainFdSolver_RNE fd(r.chain, KDL::Vector(0, 0, -9.81));
+  KDL::JntArray qdd(r.chain.getNrOfJoints());
+  KDL::Wrenches w(r.chain.getNrOfSegments(), KDL::Wrench::Zero());
+  std::size_t k = 0;
+  for (auto _ : s) {
+    const std::size_t i = k++ & 63;
+    fd.CartToJnt(r.kq[i], r.kqd[i], r.kqdd[i], w, qdd);
+    benchmark::DoNotOptimize(qdd.data.data());
+  }
+}
+// Numeric IK from the home position to the random reachable poses.
+void InverseKinematics_rp(benchmark::State& s) {
+  Robot& r = robot(s);
+  JointVector q(r.model->getNumberOfJoints());
+  IkOptions o;
+  o.positionTolerance = o.orientationTolerance = 1e-5;
+  std::size_t k = 0, solved = 0, total = 0;
+  for (auto _ : s) {
+    solved += inverseKinematics(*r.model, *r.data, r.poses[k++ & 63], r.model->getHomePosition(), q, o) == IkStatus::Solved;
+    ++total;
+  }
+  s.counters["solved"] = static_cast<double>(solved) / static_cast<double>(total);
+}
+void InverseKinematics_KDL(benchmark::State& s) {
+  Robot& r = robot(s);
+  KDL::ChainIkSolverPos_LMA ik(r.chain, 1e-5, 500, 1e-15);
+  KDL::JntArray q(r.chain.getNrOfJoints());
+  const KDL::JntArray seed = test::kdlJoints(r.model->getHomePosition());
+  std::size_t k = 0, solved = 0, total = 0;
+  for (auto _ : s) {
+    const Transform& T = r.poses[k++ & 63];
+    KDL::Frame f;
+    for (int a = 0; a < 3; ++a) {
+      f.p(a) = T(a, 3);
+      for (int b = 0; b < 3; ++b) f.M(a, b) = T(a, b);
+    }
+    solved += ik.CartToJnt(seed, f, q) >= 0;
+    ++total;
+  }
+  s.counters["solved"] = static_cast<double>(solved) / static_cast<double>(total);
+}
+
+#define RP_PAIR(name)                              \
+  BENCHMARK(name##_rp)->Arg(6)->Arg(7);            \
+  BENCHMARK(name##_KDL)->Arg(6)->Arg(7)
+
+RP_PAIR(ForwardKinematics);
+RP_PAIR(Jacobian);
+RP_PAIR(InverseDynamics);
+RP_PAIR(MassMatrix);
+RP_PAIR(ForwardDynamics);
+RP_PAIR(InverseKinematics);
+
+}  // namespace
+
+BENCHMARK_MAIN();
