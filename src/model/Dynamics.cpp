@@ -8,6 +8,8 @@
 
 #include <cmath>
 
+#include "rp/model/Kinematics.hpp"
+
 namespace rp {
 
 namespace {
@@ -117,18 +119,38 @@ void coriolisTorque(const ManipulatorModel& model, ManipulatorData& data, const 
 
 const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                               bool motorInertia) {
-  for (int j = 0; j < data.n; ++j) {
-    data.unitColumn.setZero();
-    data.unitColumn(j) = 1;
-    rnea(model, data, q, data.zero, data.unitColumn, false, motorInertia, false, nullptr, data.scratchTau);
-    data.massMatrix.col(j) = data.scratchTau;
-  }
-  // Symmetrise away rounding differences.
-  for (int i = 0; i < data.n; ++i)
-    for (int j = 0; j < i; ++j) {
-      const double m = 0.5 * (data.massMatrix(i, j) + data.massMatrix(j, i));
-      data.massMatrix(i, j) = data.massMatrix(j, i) = m;
+  // M = sum over links k of m_k Jv_k^T Jv_k + Jw_k^T I_k Jw_k, with the Jacobians of each link's
+  // centre of mass in the world frame: column j <= k is (z_{j-1} x (c_k - p_{j-1}), z_{j-1}).
+  forwardKinematics(model, data, q);
+  const int n = data.n;
+  data.massMatrix.setZero();
+  const Transform& base = model.getBaseTransform();
+  for (int k = 0; k < n; ++k) {
+    const LinkParameters& l = model.getLink(k);
+    const Transform& Tk = data.linkTransforms[static_cast<std::size_t>(k)];
+    const Eigen::Matrix3d Rk = Tk.topLeftCorner<3, 3>();
+    const V3 c = Rk * Eigen::Vector3d(l.com) + Tk.topRightCorner<3, 1>();
+    const Eigen::Matrix3d I = Rk * Eigen::Matrix3d(l.inertia) * Rk.transpose();
+    for (int j = 0; j <= k; ++j) {
+      const Transform& before = j == 0 ? base : data.linkTransforms[static_cast<std::size_t>(j - 1)];
+      const V3 z = before.block<3, 1>(0, 2);
+      data.pstar[static_cast<std::size_t>(j)] = z.cross(c - V3(before.topRightCorner<3, 1>()));  // Jv column
+      data.w[static_cast<std::size_t>(j)] = I * z;                                                // I z
     }
+    for (int i = 0; i <= k; ++i) {
+      const Transform& bi = i == 0 ? base : data.linkTransforms[static_cast<std::size_t>(i - 1)];
+      const V3 zi = bi.block<3, 1>(0, 2);
+      const V3& vi = data.pstar[static_cast<std::size_t>(i)];
+      for (int j = 0; j <= i; ++j) {
+        const double m = l.mass * vi.dot(data.pstar[static_cast<std::size_t>(j)]) + zi.dot(data.w[static_cast<std::size_t>(j)]);
+        data.massMatrix(i, j) += m;
+      }
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    if (motorInertia) data.massMatrix(i, i) += model.getArmatureInertia()(i);
+    for (int j = 0; j < i; ++j) data.massMatrix(j, i) = data.massMatrix(i, j);
+  }
   return data.massMatrix;
 }
 

@@ -58,10 +58,11 @@ void coriolisTorque(const ManipulatorModel& model, ManipulatorData& data, const 
                     JointVector& tau);
 
 /// The joint-space mass matrix \f$M(q)\f$ (symmetric, positive definite), optionally with the
-/// reflected motor inertia on its diagonal. Computed column by column with the Newton-Euler
-/// algorithm.
+/// reflected motor inertia on its diagonal. Computed from the links' centre-of-mass Jacobians,
+/// \f$M = \sum_k m_k J_{v,k}^T J_{v,k} + J_{\omega,k}^T I_k J_{\omega,k}\f$ (an algorithm
+/// independent of the Newton-Euler one, which the tests compare it with).
 /// @param[in]  model         the manipulator
-/// @param[out] data          receives `massMatrix` (n x n) [kg m^2]
+/// @param[out] data          receives `massMatrix` (n x n) [kg m^2] and the forward kinematics of `q`
 /// @param[in]  q             joint angles (n x 1) [rad]
 /// @param[in]  motorInertia  add \f$G^2 J_m\f$ to the diagonal
 /// @return `data.massMatrix`
