@@ -91,7 +91,8 @@ class RoboticPlatform {
   /// Makes `configuration` the global one (tests and programs that build it themselves).
   /// @param[in] configuration  parsed configuration
   static void setConfiguration(const Configuration& configuration);
-  /// The global configuration (empty until loaded).
+  /// The global configuration (empty until loaded). The reference stays valid until the next
+  /// setConfiguration() or loadConfiguration(); objects keep their own section alive.
   static const Configuration& getConfiguration();
 
   /// Registers the function that starts the Scene Viewer (called by init() when the GUI is on).
