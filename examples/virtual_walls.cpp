@@ -11,7 +11,7 @@
 //                  frame), to feel the wall without a GUI; the final position is printed at exit
 //
 // Changes from the paper's Figure 22:
-// 1. `int main(int argc, char* argv[])`; the loop at the end waits for Ctrl-C or --duration (the
+// 1. `int main(int argc, char* argv[])`; the end of main waits for Ctrl-C or --duration (the
 //    paper's main returned at once, which would destroy the robot) and handles --push.
 // 2. `getJointPositon` is spelled `getJointPosition`.
 // 3. The size bug: the force uses the first three wall coefficients, the normal n, instead of
@@ -96,17 +96,15 @@ int main(int argc, char* argv[]) {
 
   if (push.squaredNorm() > 0) puma.applyExternalWrench(push);
   // Run until Ctrl-C (a system shutdown) or for `duration` seconds of robot time: whole servo
-  // cycles, so the simulated clock (-simclock) stops at the same point as the real one.
-  const auto cycles = static_cast<std::uint64_t>(duration / puma.getPeriod());
-  while (!ObjectManager::isShutdownRequested() && (duration < 0 || cycles > 0)) {
-    if (duration < 0) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    } else {
-      puma.waitForCycles(cycles);
-      break;
-    }
+  // cycles, stopping a simulated clock (-simclock) exactly there.
+  if (duration >= 0) {
+    puma.runCycles(static_cast<std::uint64_t>(duration / puma.getPeriod() + 0.5));
+  } else {
+    while (!ObjectManager::isShutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   const Transform t = puma.getEndEffectorTransform();
   std::cout << "final end-effector position: " << t(0, 3) << " " << t(1, 3) << " " << t(2, 3) << std::endl;
+  puma.clearExternalWrench();
+  if (auto* clock = dynamic_cast<SimulatedClock*>(&puma.getClock())) clock->resume();
   return puma.getErrorCode() == 0 ? 0 : 1;
 }

@@ -11,6 +11,7 @@
 #include "rp/control/ServoControl.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
+#include "rp/rt/Clock.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
 
 namespace rp {
@@ -34,9 +35,9 @@ struct DefaultManipulator::WrenchBox {
       const unsigned before = sequence.load(std::memory_order_acquire);
       if (before & 1u) continue;
       Vector<6> w;
-      for (int i = 0; i < 6; ++i) w(i) = values[i].load(std::memory_order_relaxed);
-      std::atomic_thread_fence(std::memory_order_acquire);
-      if (sequence.load(std::memory_order_relaxed) == before) {
+      // Acquire loads keep the second read of the sequence after the values.
+      for (int i = 0; i < 6; ++i) w(i) = values[i].load(std::memory_order_acquire);
+      if (sequence.load(std::memory_order_acquire) == before) {
         out = w;
         return;
       }
@@ -243,6 +244,17 @@ void DefaultManipulator::startShutdown() {
 
 bool DefaultManipulator::isShutdownComplete() const { return shutdownPhase_.load() == 2; }
 
+bool DefaultManipulator::runCycles(std::uint64_t cycles, double timeoutSeconds) {
+  const std::uint64_t target = getCycleCount() + cycles;
+  if (simulatedClock_ != nullptr) pauseAtCycle_.store(target, std::memory_order_release);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeoutSeconds);
+  while (getCycleCount() < target) {
+    if (!isRunning() || std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  return true;
+}
+
 bool DefaultManipulator::waitForCycles(std::uint64_t cycles, double timeoutSeconds) const {
   const std::uint64_t target = getCycleCount() + cycles;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeoutSeconds);
@@ -255,6 +267,7 @@ bool DefaultManipulator::waitForCycles(std::uint64_t cycles, double timeoutSecon
 
 void DefaultManipulator::enterControl() {
   servoThread_.store(std::this_thread::get_id());
+  simulatedClock_ = dynamic_cast<SimulatedClock*>(&getClock());
   power_ = powerRequested_.load();
   sim_->setBrakes(!power_);
 }
@@ -350,6 +363,13 @@ void DefaultManipulator::control() {
 
   // 6. State for other threads (log samples are taken by the ControlProgram after control()).
   publish();
+
+  // runCycles() on a simulated clock: stop the clock right after the requested cycle.
+  const std::uint64_t pauseAt = pauseAtCycle_.load(std::memory_order_acquire);
+  if (pauseAt != 0 && getCycleCount() + 1 >= pauseAt && simulatedClock_ != nullptr) {
+    pauseAtCycle_.store(0, std::memory_order_relaxed);
+    simulatedClock_->pause();  // not real-time, but this is the simulated clock
+  }
 }
 
 void DefaultManipulator::checkLimits() {

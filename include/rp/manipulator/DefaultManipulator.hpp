@@ -17,6 +17,8 @@
 
 namespace rp {
 
+class SimulatedClock;
+
 /// A manipulator whose servo loop runs in its own ControlProgram thread, spawned when the object
 /// is created (paper Figure 11). Every cycle:
 /// 1. read the joints (from the arm, or from the dynamic simulation in simulation mode);
@@ -99,6 +101,12 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   /// @param[in] timeoutSeconds  longest wait in real time [s]
   /// @return false on time-out or if the loop is not running
   bool waitForCycles(std::uint64_t cycles, double timeoutSeconds = 60) const;
+  /// Runs exactly `cycles` more servo cycles: on a SimulatedClock the clock is paused right after
+  /// the last of them (call its resume() to go on), on the real clock this waits for them.
+  /// @param[in] cycles          number of cycles
+  /// @param[in] timeoutSeconds  longest wait in real time [s]
+  /// @return false on time-out or if the loop is not running
+  bool runCycles(std::uint64_t cycles, double timeoutSeconds = 60);
 
  protected:
   void enterControl() override;
@@ -136,6 +144,8 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   std::atomic<bool> holdHere_{false};
   std::atomic<int> shutdownPhase_{0};  // 0 running, 1 damped hold, 2 complete
   std::atomic<std::thread::id> servoThread_{};
+  std::atomic<std::uint64_t> pauseAtCycle_{0};
+  SimulatedClock* simulatedClock_ = nullptr;  // the loop's clock if simulated (set in enterControl)
 
   // Servo-thread state.
   JointVector q_, qd_, tau_, gravity_, hold_;
