@@ -94,6 +94,9 @@ int main(int argc, char* argv[]) {
   puma.setGravityCompensationOn();  // (3)
   puma.setServoControl(wallControl);
 
+  // On the simulated clock, hold time still while the push starts, so runs are repeatable.
+  auto* simClock = dynamic_cast<SimulatedClock*>(&puma.getClock());
+  if (simClock != nullptr && duration >= 0) simClock->pause();
   if (push.squaredNorm() > 0) puma.applyExternalWrench(push);
   // Run until Ctrl-C (a system shutdown) or for `duration` seconds of robot time: whole servo
   // cycles, stopping a simulated clock (-simclock) exactly there.
@@ -105,6 +108,6 @@ int main(int argc, char* argv[]) {
   const Transform t = puma.getEndEffectorTransform();
   std::cout << "final end-effector position: " << t(0, 3) << " " << t(1, 3) << " " << t(2, 3) << std::endl;
   puma.clearExternalWrench();
-  if (auto* clock = dynamic_cast<SimulatedClock*>(&puma.getClock())) clock->resume();
+  if (simClock != nullptr) simClock->resume();
   return puma.getErrorCode() == 0 ? 0 : 1;
 }

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <iostream>
 #include <mutex>
@@ -141,6 +142,24 @@ void RoboticPlatform::init(int& argc, char** argv, const std::string& programUsa
     if (!hardware) std::cerr << "rp: no hardware configured: every object runs in simulation mode (-nosim to change)\n";
   }
   s.initialized = true;
+  // An exception nobody catches (a robot that cannot be created, a target that cannot be
+  // reached) ends the program with its message and status 1 instead of an abort; exit() still
+  // completes the log file.
+  static std::string terminateProgram;
+  terminateProgram = program;
+  std::set_terminate([] {
+    std::string what = "unknown exception";
+    if (std::exception_ptr e = std::current_exception()) {
+      try {
+        std::rethrow_exception(e);
+      } catch (const std::exception& ex) {
+        what = ex.what();
+      } catch (...) {
+      }
+    }
+    std::cerr << terminateProgram << ": error: " << what << std::endl;
+    std::exit(1);
+  });
   internal::ensureShutdownWatcher();
   signal(SIGINT, onSignal);
   signal(SIGTERM, onSignal);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "rp/control/ServoControl.hpp"
+#include "rp/core/ObjectManager.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/rt/Clock.hpp"
@@ -57,7 +58,7 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   model_ = modelFactory(getTransform());
   if (!model_) throw std::invalid_argument("DefaultManipulator '" + getName() + "': no model");
   if (!isSimulationModeOn()) {
-    throw std::runtime_error(getClassName() + " '" + getName() +
+    throw std::runtime_error("manipulator '" + getName() +
                              "': simulation mode is off but no hardware is configured for it; switch "
                              "simulation on (-sim, or 'simulationMode on' in rp.cfg) or configure a hardware "
                              "server");
@@ -246,10 +247,15 @@ bool DefaultManipulator::isShutdownComplete() const { return shutdownPhase_.load
 
 bool DefaultManipulator::runCycles(std::uint64_t cycles, double timeoutSeconds) {
   const std::uint64_t target = getCycleCount() + cycles;
-  if (simulatedClock_ != nullptr) pauseAtCycle_.store(target, std::memory_order_release);
+  auto* simulated = dynamic_cast<SimulatedClock*>(&getClock());
+  if (simulated != nullptr) {
+    pauseAtCycle_.store(target, std::memory_order_release);
+    simulated->resume();
+  }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeoutSeconds);
   while (getCycleCount() < target) {
-    if (!isRunning() || std::chrono::steady_clock::now() > deadline) return false;
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    if (ObjectManager::isShutdownRequested() && !isRunning()) return false;
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
   return true;
@@ -367,6 +373,7 @@ void DefaultManipulator::control() {
   // runCycles() on a simulated clock: stop the clock right after the requested cycle.
   const std::uint64_t pauseAt = pauseAtCycle_.load(std::memory_order_acquire);
   if (pauseAt != 0 && getCycleCount() + 1 >= pauseAt && simulatedClock_ != nullptr) {
+    // getCycleCount() counts finished cycles; this one finishes next.
     pauseAtCycle_.store(0, std::memory_order_relaxed);
     simulatedClock_->pause();  // not real-time, but this is the simulated clock
   }

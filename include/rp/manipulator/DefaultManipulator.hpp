@@ -101,8 +101,9 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   /// @param[in] timeoutSeconds  longest wait in real time [s]
   /// @return false on time-out or if the loop is not running
   bool waitForCycles(std::uint64_t cycles, double timeoutSeconds = 60) const;
-  /// Runs exactly `cycles` more servo cycles: on a SimulatedClock the clock is paused right after
-  /// the last of them (call its resume() to go on), on the real clock this waits for them.
+  /// Runs exactly `cycles` more servo cycles: on a SimulatedClock it resumes the clock (pause it
+  /// first to start from a known cycle) and pauses it right after the last of them (call its
+  /// resume() to go on); on the real clock this waits for them.
   /// @param[in] cycles          number of cycles
   /// @param[in] timeoutSeconds  longest wait in real time [s]
   /// @return false on time-out or if the loop is not running
