@@ -180,6 +180,19 @@ void InverseKinematics_KDL(benchmark::State& s) {
   s.counters["solved"] = static_cast<double>(solved) / static_cast<double>(total);
 }
 
+// All eight closed-form branches of the Puma 560 (the goal: under 2 us).
+void Puma560ClosedFormIk_rp(benchmark::State& s) {
+  Robot& r = puma();
+  const auto& model = static_cast<const Puma560Model&>(*r.model);
+  std::array<Puma560IkSolution, 8> all;
+  std::size_t k = 0;
+  for (auto _ : s) {
+    model.inverseKinematicsAll(r.poses[k++ & 63], all);
+    benchmark::DoNotOptimize(all.data());
+  }
+}
+BENCHMARK(Puma560ClosedFormIk_rp);
+
 #define RP_PAIR(name)                              \
   BENCHMARK(name##_rp)->Arg(6)->Arg(7);            \
   BENCHMARK(name##_KDL)->Arg(6)->Arg(7)

@@ -5,6 +5,10 @@
 #include "rp/manipulator/Manipulator.hpp"
 #include "rp/model/InverseKinematics.hpp"
 #include "rp/model/Kinematics.hpp"
+#include "rp/model/Puma560Model.hpp"
+
+#include <array>
+#include <cmath>
 
 namespace rp {
 
@@ -20,6 +24,29 @@ JointVector DefaultTrajectoryGenerator<N>::solvePose(const Transform& pose) {
   ManipulatorData data(model);
   const JointVector seed = getLastTarget();
   JointVector q(model.getNumberOfJoints());
+  if (const auto* puma = dynamic_cast<const Puma560Model*>(&model)) {
+    // Closed form: stay on the branch (shoulder, elbow, wrist) the arm is on at the start.
+    std::array<Puma560IkSolution, 8> start, goal;
+    const Transform from = forwardKinematics(model, data, seed);
+    if (puma->inverseKinematicsAll(from, start) == IkStatus::Solved &&
+        puma->inverseKinematicsAll(pose, goal) == IkStatus::Solved) {
+      int branch = -1;
+      double best = INFINITY;
+      for (int b = 0; b < 8; ++b) {
+        const double d = (start[static_cast<std::size_t>(b)].q - seed).cwiseAbs().maxCoeff();
+        if (d < best) {
+          best = d;
+          branch = b;
+        }
+      }
+      if (branch >= 0 && goal[static_cast<std::size_t>(branch)].withinLimits) return goal[static_cast<std::size_t>(branch)].q;
+    }
+    if (puma->inverseKinematicsClosest(pose, seed, q) == IkStatus::Solved) return q;
+    const Vector<3> p = getPosition(pose);
+    throw std::invalid_argument(getName() + ": '" + m.getName() + "' cannot reach the pose at (" + std::to_string(p(0)) +
+                                ", " + std::to_string(p(1)) + ", " + std::to_string(p(2)) +
+                                ") m with any of its eight configurations within the joint limits");
+  }
   IkOptions options;
   options.positionTolerance = 1e-7;
   options.orientationTolerance = 1e-7;

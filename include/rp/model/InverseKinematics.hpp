@@ -12,6 +12,7 @@ namespace rp {
 enum class IkStatus {
   Solved,         ///< the pose is reached within the tolerance, inside the joint limits
   NotConverged,   ///< no solution found within the iteration budget (unreachable or too hard)
+  Unreachable,    ///< the pose is out of the arm's reach (closed-form solvers know it)
 };
 
 /// Settings of the numeric inverse kinematics.
