@@ -8,4 +8,5 @@
 #include "rp/model/ManipulatorData.hpp"
 #include "rp/model/ManipulatorModel.hpp"
 #include "rp/model/Puma560Model.hpp"
+#include "rp/model/UrdfExport.hpp"
 #include "rp/model/WAMModel.hpp"

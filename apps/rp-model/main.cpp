@@ -1,0 +1,188 @@
+// rp-model: kinematics and dynamics of a built-in robot from the command line, as JSON.
+//
+//   rp-model --robot puma560|wam4|wam7 COMMAND --q v1,v2,... [options]
+//
+// COMMAND: fk | jacobian | gravity | rnea --qd .. --qdd .. | inertia | fd --qd .. --tau .. |
+//          ik --pose p1,...,p16 [--seed ..] | urdf
+// Options: --motor-inertia and --friction add those effects to inertia, rnea and fd.
+// Units: SI and radians. Matrices are JSON arrays of rows. Bad input: one line on stderr, exit 2.
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "rp/model/Model.hpp"
+
+namespace {
+
+using namespace rp;
+using nlohmann::json;
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::vector<double> numbers(const std::string& option, const std::string& text) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || end == item.c_str() || *end != '\0') {
+      throw UsageError(option + ": '" + item + "' is not a number");
+    }
+    v.push_back(x);
+  }
+  return v;
+}
+
+JointVector jointsOf(const std::map<std::string, std::string>& opts, const std::string& name, int n, bool required) {
+  const auto it = opts.find(name);
+  if (it == opts.end()) {
+    if (required) throw UsageError("missing " + name + " (" + std::to_string(n) + " comma-separated values)");
+    return JointVector(n);
+  }
+  const std::vector<double> v = numbers(name, it->second);
+  if (static_cast<int>(v.size()) != n) {
+    throw UsageError(name + " has " + std::to_string(v.size()) + " values; the robot has " + std::to_string(n) +
+                     " joints");
+  }
+  JointVector q(n);
+  for (int i = 0; i < n; ++i) q(i) = v[static_cast<std::size_t>(i)];
+  return q;
+}
+
+template <typename M>
+json matrix(const M& m) {
+  json rows = json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    json row = json::array();
+    for (Eigen::Index c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+json vector(const JointVector& v) {
+  json a = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
+  return a;
+}
+
+int run(int argc, char** argv) {
+  std::map<std::string, std::string> opts;
+  std::string command;
+  const std::vector<std::string> flags = {"--motor-inertia", "--friction"};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::cout << "usage: rp-model --robot puma560|wam4|wam7 COMMAND --q v1,v2,... [--qd ..] [--qdd ..] [--tau ..]\n"
+                   "                [--pose p1,...,p16] [--seed ..] [--motor-inertia] [--friction]\n"
+                   "COMMAND: fk jacobian gravity rnea inertia fd ik urdf\n";
+      return 0;
+    }
+    if (a == "--motor-inertia" || a == "--friction") {
+      opts[a] = "1";
+    } else if (a.rfind("--", 0) == 0) {
+      if (i + 1 >= argc) throw UsageError(a + " needs a value");
+      opts[a] = argv[++i];
+    } else if (command.empty()) {
+      command = a;
+    } else {
+      throw UsageError("unexpected argument '" + a + "'");
+    }
+  }
+  const auto robotIt = opts.find("--robot");
+  if (robotIt == opts.end()) throw UsageError("missing --robot puma560|wam4|wam7");
+  std::unique_ptr<ManipulatorModel> model;
+  const std::string robot = robotIt->second;
+  if (robot == "puma560") model = std::make_unique<Puma560Model>();
+  else if (robot == "wam7") model = std::make_unique<WAM7Model>();
+  else if (robot == "wam4") model = std::make_unique<WAM4Model>();
+  else if (robot.size() > 5 && robot.substr(robot.size() - 5) == ".urdf")
+    throw UsageError("loading URDF files is not supported yet (built-in robots: puma560, wam4, wam7)");
+  else throw UsageError("unknown robot '" + robot + "' (known: puma560, wam4, wam7)");
+  if (opts.count("--tip")) throw UsageError("--tip applies to URDF robots only");
+  for (const auto& [key, value] : opts) {
+    static const std::vector<std::string> known = {"--robot", "--q", "--qd", "--qdd", "--tau", "--pose", "--seed",
+                                                   "--motor-inertia", "--friction"};
+    if (std::find(known.begin(), known.end(), key) == known.end()) throw UsageError("unknown option " + key);
+    (void)value;
+  }
+  const int n = model->getNumberOfJoints();
+  ManipulatorData data(*model);
+  DynamicsOptions dyn;
+  dyn.motorInertia = opts.count("--motor-inertia") > 0;
+  dyn.friction = opts.count("--friction") > 0;
+  json out;
+  if (command == "urdf") {
+    std::cout << toUrdf(*model);
+    return 0;
+  } else if (command == "ik") {
+    const auto poseIt = opts.find("--pose");
+    if (poseIt == opts.end()) throw UsageError("ik needs --pose with 16 values (a 4x4 matrix, row-major)");
+    const std::vector<double> p = numbers("--pose", poseIt->second);
+    if (p.size() != 16) throw UsageError("--pose has " + std::to_string(p.size()) + " values; give 16 (4x4, row-major)");
+    Transform T;
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) T(r, c) = p[static_cast<std::size_t>(4 * r + c)];
+    json solutions = json::array();
+    if (const auto* puma = dynamic_cast<const Puma560Model*>(model.get())) {
+      std::array<Puma560IkSolution, 8> all;
+      if (puma->inverseKinematicsAll(T, all) != IkStatus::Solved) throw UsageError("the pose is out of reach");
+      for (const Puma560IkSolution& s : all)
+        solutions.push_back({{"q", vector(s.q)}, {"branch", s.branchName()}, {"withinLimits", s.withinLimits}});
+    } else {
+      const JointVector seed = opts.count("--seed") ? jointsOf(opts, "--seed", n, true) : model->getHomePosition();
+      JointVector q(n);
+      if (inverseKinematics(*model, data, T, seed, q) != IkStatus::Solved)
+        throw UsageError("no solution found within the joint limits (unreachable pose?)");
+      solutions.push_back({{"q", vector(q)}, {"branch", "numeric"}, {"withinLimits", model->isWithinLimits(q)}});
+    }
+    out["solutions"] = solutions;
+  } else {
+    const JointVector q = jointsOf(opts, "--q", n, true);
+    if (command == "fk") {
+      out["fk"] = matrix(forwardKinematics(*model, data, q));
+    } else if (command == "jacobian") {
+      out["jacobian"] = matrix(jacobian(*model, data, q));
+    } else if (command == "gravity") {
+      JointVector g(n);
+      gravityTorque(*model, data, q, g);
+      out["tau"] = vector(g);
+    } else if (command == "rnea") {
+      out["tau"] = vector(inverseDynamics(*model, data, q, jointsOf(opts, "--qd", n, true),
+                                          jointsOf(opts, "--qdd", n, true), dyn));
+    } else if (command == "inertia") {
+      out["M"] = matrix(massMatrix(*model, data, q, dyn.motorInertia));
+    } else if (command == "fd") {
+      out["qdd"] = vector(forwardDynamics(*model, data, q, jointsOf(opts, "--qd", n, true),
+                                          jointsOf(opts, "--tau", n, true), dyn));
+    } else {
+      throw UsageError(command.empty() ? "missing COMMAND (fk jacobian gravity rnea inertia fd ik urdf)"
+                                       : "unknown command '" + command + "' (fk jacobian gravity rnea inertia fd ik urdf)");
+    }
+  }
+  std::cout << out.dump() << std::endl;
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "rp-model: " << e.what() << std::endl;
+    return 2;
+  }
+}
