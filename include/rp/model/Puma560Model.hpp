@@ -9,16 +9,6 @@
 
 namespace rp {
 
-/// The Unimation Puma 560: standard DH kinematics and dynamics as published in Peter Corke's
-/// Robotics Toolbox (Python `models/DH/Puma560.py`, MATLAB `mdl_puma560.m`), which take them from
-/// Corke & Armstrong-Helouvry, "A search for consensus among model parameters reported for the
-/// PUMA 560 robot", ICRA 1994. Joint limits as in the Python toolbox (Wang & Chen 1991).
-///
-/// The pedestal height d1 is 0.67183 m (26.45 in) by default, as in the Python toolbox; the
-/// MATLAB toolbox uses 0. Motor inertia, gear ratios and friction are the toolbox's (motor side).
-/// Velocity and torque limits are not part of the toolbox model: the values here are assumed,
-/// documented in docs/models.md, and are settable by deriving.
-/// Home position: the toolbox's `qr` ready pose (0, 90°, -90°, 0, 0, 0).
 /// One closed-form inverse kinematics solution of the Puma 560 and its branch.
 struct Puma560IkSolution {
   JointVector q;              ///< joint angles (6 x 1) [rad], q1..q3 and q4, q6 in (-pi, pi]
@@ -31,6 +21,16 @@ struct Puma560IkSolution {
   const char* branchName() const;
 };
 
+/// The Unimation Puma 560: standard DH kinematics and dynamics as published in Peter Corke's
+/// Robotics Toolbox (Python `models/DH/Puma560.py`, MATLAB `mdl_puma560.m`), which take them from
+/// Corke & Armstrong-Helouvry, "A search for consensus among model parameters reported for the
+/// PUMA 560 robot", ICRA 1994. Joint limits as in the Python toolbox (Wang & Chen 1991).
+///
+/// The pedestal height d1 is 0.67183 m (26.45 in) by default, as in the Python toolbox; the
+/// MATLAB toolbox uses 0. Motor inertia, gear ratios and friction are the toolbox's (motor side).
+/// Velocity and torque limits are not part of the toolbox model: the values here are assumed,
+/// documented in docs/models.md, and are settable by deriving.
+/// Home position: the toolbox's `qr` ready pose (0, 90°, -90°, 0, 0, 0).
 class Puma560Model : public ManipulatorModel {
  public:
   /// Creates the model.
