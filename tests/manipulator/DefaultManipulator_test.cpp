@@ -5,7 +5,9 @@
 
 #include <atomic>
 #include <cmath>
+#include <chrono>
 #include <numbers>
+#include <thread>
 
 #include "AllocationCounter.hpp"
 #include "rp/RoboticPlatform.hpp"
@@ -245,6 +247,11 @@ TEST_F(ManipulatorTest, TwoArmsRunTogetherDeterministically) {
     simClock().pause();
     Puma560 first;
     WAM second("", 7);
+    // A loop runs its first cycle as soon as its thread starts, even on a paused clock: wait for
+    // both, so that nothing below races with a thread that starts late.
+    while (first.getCycleCount() < 1 || second.getCycleCount() < 1) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
     JointVector ta = first.getModel().getHomePosition(), tb = second.getModel().getHomePosition();
     ta(1) += 0.01;
     tb(0) += 0.01;

@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <chrono>
 #include <numbers>
+#include <thread>
 
 #include "AllocationCounter.hpp"
 #include "rp/RoboticPlatform.hpp"
@@ -90,6 +92,8 @@ TEST_F(TrajectoryTest, SetpointEvaluationDoesNotAllocateAndStaysWithinLimits) {
   sp.position = sp.velocity = sp.acceleration = JointVector(6);
   SimulatedClock& clock = dynamic_cast<SimulatedClock&>(RoboticPlatform::getDefaultClock());
   clock.pause();  // evaluate here, not in the servo thread
+  // The loop runs its first cycle when its thread starts, even on a paused clock: let it.
+  while (puma.getCycleCount() < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   puma.clearTrajectoryGenerator();
   puma.setTrajectoryGenerator(tragen);
   Vector<6> target;
