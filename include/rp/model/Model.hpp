@@ -9,4 +9,5 @@
 #include "rp/model/ManipulatorModel.hpp"
 #include "rp/model/Puma560Model.hpp"
 #include "rp/model/UrdfExport.hpp"
+#include "rp/model/UrdfModel.hpp"
 #include "rp/model/WAMModel.hpp"

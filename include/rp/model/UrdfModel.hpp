@@ -1,0 +1,47 @@
+#pragma once
+/// @file
+/// Loading a manipulator model from a URDF file (liburdfdom), for any serial arm.
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "rp/model/ManipulatorModel.hpp"
+
+namespace rp {
+
+/// Error loading a URDF file; the message starts with the file name.
+class UrdfError : public std::runtime_error {
+ public:
+  /// Creates the error.
+  /// @param[in] message  `FILE: what is wrong`
+  explicit UrdfError(const std::string& message) : std::runtime_error(message) {}
+};
+
+/// Options of loadUrdf().
+struct UrdfOptions {
+  std::string tip;               ///< last link of the chain; empty: the last movable link of an unbranched chain
+  bool requireDynamics = false;  ///< refuse links without inertial data (simulation needs them)
+};
+
+/// Loads the serial chain from the URDF root link to a tip link as a ManipulatorModel.
+///
+/// Revolute and continuous joints become the model's joints, fixed joints are merged into the
+/// links around them (their inertias combined about the common centre of mass), and the chain is
+/// re-expressed in standard Denavit-Hartenberg frames (always possible for revolute joints): the
+/// base transform places DH frame 0 in the URDF root frame and the tool transform places the tip
+/// link in the last DH frame, so forward kinematics equals the URDF's for every joint vector and
+/// joint angles keep the URDF's zero and sign. Limits come from `<limit>` (continuous joints get
+/// +-2 pi; a missing effort or velocity the ManipulatorModel defaults); `<dynamics damping
+/// friction>` become viscous and Coulomb friction.
+/// @param[in] fileName  path of the URDF file
+/// @param[in] options   tip link and whether dynamics are required
+/// @return the model, named after the robot
+/// @throws UrdfError naming the file for: a missing or unreadable file, malformed XML or URDF, a
+///         floating, planar or prismatic joint in the chain, an unknown tip, a branching robot
+///         without a tip, no movable joint, and (with requireDynamics) a moving link without
+///         inertial data
+/// Real-time safe: no.
+std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options = UrdfOptions());
+
+}  // namespace rp

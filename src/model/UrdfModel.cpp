@@ -1,0 +1,255 @@
+// Loading manipulator models from URDF (rp/model/UrdfModel.hpp).
+#include "rp/model/UrdfModel.hpp"
+
+#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <sstream>
+#include <vector>
+
+#include "rp/model/Kinematics.hpp"
+
+namespace rp {
+
+namespace {
+
+using V3 = Eigen::Vector3d;
+
+Transform toTransform(const urdf::Pose& p) {
+  Transform t = Transform::unit();
+  t.topLeftCorner<3, 3>() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).toRotationMatrix();
+  t(0, 3) = p.position.x;
+  t(1, 3) = p.position.y;
+  t(2, 3) = p.position.z;
+  return t;
+}
+
+// A rigid body accumulated in root coordinates (at q = 0).
+struct Body {
+  double mass = 0;
+  V3 moment = V3::Zero();           // sum of m c
+  Eigen::Matrix3d inertiaAtOrigin;  // sum of I_c + m (|c|^2 1 - c c^T), about the root origin
+  bool any = false;
+  Body() { inertiaAtOrigin.setZero(); }
+  void add(double m, const V3& c, const Eigen::Matrix3d& Ic) {
+    mass += m;
+    moment += m * c;
+    inertiaAtOrigin += Ic + m * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+    any = true;
+  }
+};
+
+struct Line {
+  V3 point, direction;
+};
+
+// The DH frame whose z is `axis` and whose origin lies on it, with x along the common normal
+// from the previous frame's z axis (or a free perpendicular).
+Transform frame(const V3& origin, const V3& z, const V3& x) {
+  Transform f = Transform::unit();
+  f.block<3, 1>(0, 0) = x;
+  f.block<3, 1>(0, 1) = z.cross(x);
+  f.block<3, 1>(0, 2) = z;
+  f.topRightCorner<3, 1>() = origin;
+  return f;
+}
+
+V3 anyPerpendicular(const V3& z) {
+  const V3 trial = std::abs(z.x()) < 0.9 ? V3::UnitX() : V3::UnitY();
+  return (trial - trial.dot(z) * z).normalized();
+}
+
+}  // namespace
+
+std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options) {
+  std::ifstream in(fileName);
+  if (!in) throw UrdfError(fileName + ": cannot read the file");
+  std::stringstream text;
+  text << in.rdbuf();
+  const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text.str());
+  if (!robot) throw UrdfError(fileName + ": not a valid URDF document (malformed XML or URDF structure)");
+  const urdf::LinkConstSharedPtr root = robot->getRoot();
+  if (!root) throw UrdfError(fileName + ": the robot has no root link");
+
+  // The chain of joints from the root to the tip.
+  urdf::LinkConstSharedPtr tip;
+  if (!options.tip.empty()) {
+    tip = robot->getLink(options.tip);
+    if (!tip) throw UrdfError(fileName + ": there is no link '" + options.tip + "'");
+  } else {
+    urdf::LinkConstSharedPtr link = root, lastMovable;
+    while (!link->child_joints.empty()) {
+      if (link->child_joints.size() > 1) {
+        throw UrdfError(fileName + ": the robot branches at link '" + link->name + "'; name the tip link");
+      }
+      const urdf::JointConstSharedPtr j = link->child_joints.front();
+      link = robot->getLink(j->child_link_name);
+      if (j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS) lastMovable = link;
+    }
+    tip = lastMovable ? lastMovable : link;
+  }
+  std::vector<urdf::JointConstSharedPtr> chain;
+  for (urdf::LinkConstSharedPtr link = tip; link->parent_joint; link = robot->getLink(link->parent_joint->parent_link_name)) {
+    chain.push_back(link->parent_joint);
+  }
+  std::reverse(chain.begin(), chain.end());
+
+  // Poses at q = 0 in root coordinates; movable joints' lines; bodies per movable joint.
+  std::vector<Line> axes;
+  std::vector<urdf::JointConstSharedPtr> movable;
+  std::vector<Body> bodies;
+  Transform linkPose = Transform::unit();
+  std::vector<std::string> chainLinks;
+  for (const urdf::JointConstSharedPtr& j : chain) chainLinks.push_back(j->child_link_name);
+  // A link's inertia and that of everything fixed to it off the chain (e.g. a camera).
+  std::function<void(const urdf::LinkConstSharedPtr&, const Transform&)> addInertial =
+      [&](const urdf::LinkConstSharedPtr& link, const Transform& pose) {
+        if (bodies.empty()) return;  // links before the first joint belong to the base
+        if (link->inertial) {
+          const Transform in = Transform(pose * toTransform(link->inertial->origin));
+          const Eigen::Matrix3d R = in.topLeftCorner<3, 3>();
+          Eigen::Matrix3d I;
+          const urdf::Inertial& i = *link->inertial;
+          I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
+          bodies.back().add(i.mass, in.topRightCorner<3, 1>(), R * I * R.transpose());
+        }
+        for (const urdf::JointSharedPtr& c : link->child_joints) {
+          if (c->type != urdf::Joint::FIXED) continue;
+          if (std::find(chainLinks.begin(), chainLinks.end(), c->child_link_name) != chainLinks.end()) continue;
+          addInertial(robot->getLink(c->child_link_name), Transform(pose * toTransform(c->parent_to_joint_origin_transform)));
+        }
+      };
+  for (const urdf::JointConstSharedPtr& j : chain) {
+    const Transform jointFrame = Transform(linkPose * toTransform(j->parent_to_joint_origin_transform));
+    switch (j->type) {
+      case urdf::Joint::REVOLUTE:
+      case urdf::Joint::CONTINUOUS: {
+        V3 axis(j->axis.x, j->axis.y, j->axis.z);
+        if (axis.norm() < 1e-12) throw UrdfError(fileName + ": joint '" + j->name + "' has a zero axis");
+        axis = jointFrame.topLeftCorner<3, 3>() * axis.normalized();
+        axes.push_back({V3(jointFrame.topRightCorner<3, 1>()), axis});
+        movable.push_back(j);
+        bodies.emplace_back();
+        break;
+      }
+      case urdf::Joint::FIXED:
+        break;
+      case urdf::Joint::PRISMATIC:
+        throw UrdfError(fileName + ": joint '" + j->name + "' is prismatic; only revolute, continuous and fixed joints are supported");
+      default:
+        throw UrdfError(fileName + ": joint '" + j->name + "' is floating or planar; a manipulator is a chain of revolute, continuous and fixed joints");
+    }
+    linkPose = jointFrame;
+    addInertial(robot->getLink(j->child_link_name), linkPose);
+  }
+  const int n = static_cast<int>(axes.size());
+  if (n == 0) throw UrdfError(fileName + ": no revolute or continuous joint between the root and '" + tip->name + "'");
+  if (n > kMaxJoints) throw UrdfError(fileName + ": " + std::to_string(n) + " joints; at most " + std::to_string(kMaxJoints));
+
+  // Standard DH frames F_0..F_n in root coordinates: z_{i-1} along joint i's axis, x_i along the
+  // common normal from axis i to axis i+1, origin of F_i on axis i+1; F_n = F_{n-1}.
+  std::vector<Transform> F(static_cast<std::size_t>(n + 1));
+  std::vector<V3> origin(static_cast<std::size_t>(n + 1)), xs(static_cast<std::size_t>(n + 1));
+  for (int i = 1; i < n; ++i) {  // frame i from axes i-1 and i (0-based lines)
+    const Line& a = axes[static_cast<std::size_t>(i - 1)];
+    const Line& b = axes[static_cast<std::size_t>(i)];
+    const V3 cross = a.direction.cross(b.direction);
+    V3 o, x;
+    if (cross.norm() > 1e-9) {
+      // Closest points of the two lines.
+      const V3 w = a.point - b.point;
+      const double A = a.direction.dot(a.direction), B = a.direction.dot(b.direction), C = b.direction.dot(b.direction),
+                   D = a.direction.dot(w), E = b.direction.dot(w), den = A * C - B * B;
+      const double t = (B * E - C * D) / den, s = (A * E - B * D) / den;
+      const V3 pa = a.point + t * a.direction, pb = b.point + s * b.direction;
+      o = pb;
+      x = (pb - pa).norm() > 1e-9 ? V3((pb - pa).normalized()) : V3(cross.normalized());
+    } else {
+      // Parallel axes: origin where the perpendicular from the previous origin meets axis i.
+      const V3 prev = i == 1 ? a.point : origin[static_cast<std::size_t>(i - 1)];
+      const V3 foot = b.point + (prev - b.point).dot(b.direction) * b.direction;
+      o = foot;
+      const V3 between = foot - prev - (foot - prev).dot(a.direction) * a.direction;
+      x = between.norm() > 1e-9 ? V3(between.normalized()) : V3::Zero();
+    }
+    origin[static_cast<std::size_t>(i)] = o;
+    xs[static_cast<std::size_t>(i)] = x;
+  }
+  // Frame 0: on axis 0 with x along frame 1's x if that is perpendicular, else any perpendicular.
+  const V3 z0 = axes[0].direction;
+  V3 x0 = n > 1 && xs[1].norm() > 0.5 ? xs[1] : anyPerpendicular(z0);
+  x0 = (x0 - x0.dot(z0) * z0).normalized();
+  origin[0] = axes[0].point;
+  F[0] = frame(origin[0], z0, x0);
+  for (int i = 1; i < n; ++i) {
+    V3 x = xs[static_cast<std::size_t>(i)];
+    const V3 z = axes[static_cast<std::size_t>(i)].direction;
+    if (x.norm() < 0.5) x = F[static_cast<std::size_t>(i - 1)].block<3, 1>(0, 0);  // coincident axes: keep x
+    x = (x - x.dot(z) * z).normalized();
+    F[static_cast<std::size_t>(i)] = frame(origin[static_cast<std::size_t>(i)], z, x);
+  }
+  F[static_cast<std::size_t>(n)] = F[static_cast<std::size_t>(n - 1)];
+
+  std::vector<LinkParameters> links(static_cast<std::size_t>(n));
+  for (int i = 1; i <= n; ++i) {
+    const Transform& P = F[static_cast<std::size_t>(i - 1)];
+    const Transform& Q = F[static_cast<std::size_t>(i)];
+    const V3 zp = P.block<3, 1>(0, 2), xp = P.block<3, 1>(0, 0), zq = Q.block<3, 1>(0, 2), xq = Q.block<3, 1>(0, 0);
+    const V3 dp = Q.topRightCorner<3, 1>() - P.topRightCorner<3, 1>();
+    LinkParameters& l = links[static_cast<std::size_t>(i - 1)];
+    l.a = dp.dot(xq);
+    l.d = dp.dot(zp);
+    l.alpha = std::atan2(zp.cross(zq).dot(xq), zp.dot(zq));
+    l.offset = std::atan2(xp.cross(xq).dot(zp), xp.dot(xq));
+    const urdf::JointConstSharedPtr& j = movable[static_cast<std::size_t>(i - 1)];
+    if (j->type == urdf::Joint::CONTINUOUS || !j->limits) {
+      l.positionMin = -2 * std::numbers::pi;
+      l.positionMax = 2 * std::numbers::pi;
+    } else {
+      l.positionMin = j->limits->lower;
+      l.positionMax = j->limits->upper;
+    }
+    if (j->limits && j->limits->effort > 0) l.torqueLimit = j->limits->effort;
+    if (j->limits && j->limits->velocity > 0) l.velocityLimit = j->limits->velocity;
+    if (j->dynamics) {
+      l.viscousFriction = j->dynamics->damping;
+      l.coulombFrictionPositive = j->dynamics->friction;
+      l.coulombFrictionNegative = -j->dynamics->friction;
+    }
+    // Inertia of the link (and what is fixed to it) in DH frame i.
+    const Body& body = bodies[static_cast<std::size_t>(i - 1)];
+    const std::string childName = j->child_link_name;
+    if (!body.any) {
+      if (options.requireDynamics) {
+        throw UrdfError(fileName + ": link '" + childName + "' has no inertial data (needed for dynamics and simulation)");
+      }
+      continue;
+    }
+    // A massless link may still have rotational inertia (the Puma's link 1); its centre of mass
+    // is then immaterial and taken at the frame origin.
+    const V3 c = body.mass > 0 ? V3(body.moment / body.mass) : V3(Q.topRightCorner<3, 1>());
+    const Eigen::Matrix3d Ic =
+        body.inertiaAtOrigin - body.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+    const Eigen::Matrix3d R = Q.topLeftCorner<3, 3>();
+    l.mass = body.mass;
+    l.com = Vector<3>(R.transpose() * (c - V3(Q.topRightCorner<3, 1>())));
+    l.inertia = Matrix<3, 3>(R.transpose() * Ic * R);
+  }
+  const Transform tool = Transform(rigidInverse(F[static_cast<std::size_t>(n)]) * linkPose);
+  auto model = std::make_unique<ManipulatorModel>(robot->getName(), links, F[0], tool);
+  // Self-check: the DH chain must reproduce the URDF's poses at q = 0.
+  ManipulatorData data(*model);
+  const Transform& T = forwardKinematics(*model, data, JointVector(n));
+  if ((T - linkPose).cwiseAbs().maxCoeff() > 1e-9) {
+    throw UrdfError(fileName + ": internal error converting the chain to DH frames");
+  }
+  return model;
+}
+
+}  // namespace rp

@@ -1,0 +1,196 @@
+// Loading arms from URDF: forward kinematics against a direct walk of the URDF (urdfdom),
+// dynamics against Orocos KDL built from the same URDF with KDL's own API, a round trip through
+// the exporter, and clear errors for bad files.
+#include <gtest/gtest.h>
+
+#include <urdf_parser/urdf_parser.h>
+
+#include <kdl/chain.hpp>
+#include <kdl/chaindynparam.hpp>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "KdlChain.hpp"
+#include "rp/model/Dynamics.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/model/Puma560Model.hpp"
+#include "rp/model/UrdfExport.hpp"
+#include "rp/model/UrdfModel.hpp"
+
+namespace rp {
+namespace {
+
+const std::string kData = RP_TEST_DATA_DIR;
+
+Transform pose(const urdf::Pose& p) {
+  Transform t = Transform::unit();
+  t.topLeftCorner<3, 3>() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).toRotationMatrix();
+  t(0, 3) = p.position.x;
+  t(1, 3) = p.position.y;
+  t(2, 3) = p.position.z;
+  return t;
+}
+
+urdf::ModelInterfaceSharedPtr parse(const std::string& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return urdf::parseURDF(s.str());
+}
+
+std::vector<urdf::JointConstSharedPtr> chainTo(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip) {
+  std::vector<urdf::JointConstSharedPtr> chain;
+  for (auto link = robot->getLink(tip); link->parent_joint; link = robot->getLink(link->parent_joint->parent_link_name))
+    chain.push_back(link->parent_joint);
+  std::reverse(chain.begin(), chain.end());
+  return chain;
+}
+
+KDL::Frame kdlFrame(const Transform& t) {
+  KDL::Frame f;
+  for (int r = 0; r < 3; ++r) {
+    f.p(r) = t(r, 3);
+    for (int c = 0; c < 3; ++c) f.M(r, c) = t(r, c);
+  }
+  return f;
+}
+
+KDL::RigidBodyInertia kdlInertia(const urdf::Inertial& i) {
+  const Transform T = pose(i.origin);
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  Eigen::Matrix3d I;
+  I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
+  const Eigen::Matrix3d Il = R * I * R.transpose();
+  return KDL::RigidBodyInertia(i.mass, KDL::Vector(T(0, 3), T(1, 3), T(2, 3)),
+                               KDL::RotationalInertia(Il(0, 0), Il(1, 1), Il(2, 2), Il(0, 1), Il(0, 2), Il(1, 2)));
+}
+
+// The KDL chain of the URDF, the way kdl_parser builds it; the camera (fixed to l3, off the chain)
+// is added to l3's inertia.
+KDL::Chain kdlFromUrdf(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip) {
+  KDL::Chain chain;
+  for (const urdf::JointConstSharedPtr& j : chainTo(robot, tip)) {
+    const KDL::Frame origin = kdlFrame(pose(j->parent_to_joint_origin_transform));
+    const urdf::LinkConstSharedPtr child = robot->getLink(j->child_link_name);
+    KDL::RigidBodyInertia inertia = child->inertial ? kdlInertia(*child->inertial) : KDL::RigidBodyInertia::Zero();
+    for (const urdf::JointSharedPtr& c : child->child_joints) {
+      if (c->child_link_name == "camera") {
+        inertia = inertia + kdlFrame(pose(c->parent_to_joint_origin_transform)) * kdlInertia(*robot->getLink("camera")->inertial);
+      }
+    }
+    if (j->type == urdf::Joint::FIXED) {
+      chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, KDL::Joint::Fixed), origin, inertia));
+    } else {
+      const KDL::Vector axis = origin.M * KDL::Vector(j->axis.x, j->axis.y, j->axis.z);
+      chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, origin.p, axis, KDL::Joint::RotAxis),
+                                    origin, inertia));
+    }
+  }
+  return chain;
+}
+
+TEST(UrdfModel, ForwardKinematicsAndDynamicsMatchUrdfdomAndKdl) {
+  UrdfOptions options;
+  options.tip = "tool";
+  options.requireDynamics = true;
+  const std::unique_ptr<ManipulatorModel> model = loadUrdf(kData + "/test_arm.urdf", options);
+  ASSERT_EQ(model->getNumberOfJoints(), 6);
+  EXPECT_EQ(model->getName(), "test_arm");
+  EXPECT_DOUBLE_EQ(model->getTorqueLimit()(0), 80);
+  EXPECT_DOUBLE_EQ(model->getPositionMax()(1), 2.0);
+  const urdf::ModelInterfaceSharedPtr robot = parse(kData + "/test_arm.urdf");
+  const KDL::Chain chain = kdlFromUrdf(robot, "tool");
+  KDL::ChainIdSolver_RNE id(chain, KDL::Vector(0, 0, -9.81));
+  KDL::ChainJntToJacSolver jac(chain);
+  KDL::ChainDynParam dyn(chain, KDL::Vector(0, 0, -9.81));
+  ManipulatorData data(*model);
+  std::mt19937_64 rng(77);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 500; ++trial) {
+    JointVector q(6), qd(6), qdd(6);
+    for (int i = 0; i < 6; ++i) {
+      q(i) = 2 * u(rng);
+      qd(i) = u(rng);
+      qdd(i) = 3 * u(rng);
+    }
+    // Walk the URDF: T = prod origin_j * Rot(axis_j, q_j).
+    Transform T = Transform::unit();
+    int k = 0;
+    for (const urdf::JointConstSharedPtr& j : chainTo(robot, "tool")) {
+      T = Transform(T * pose(j->parent_to_joint_origin_transform));
+      if (j->type != urdf::Joint::FIXED) T = Transform(T * rotation(Vector<3>{{j->axis.x}, {j->axis.y}, {j->axis.z}}, q(k++)));
+    }
+    ASSERT_LT((forwardKinematics(*model, data, q) - T).cwiseAbs().maxCoeff(), 1e-12);
+
+    const KDL::JntArray kq = test::kdlJoints(q), kqd = test::kdlJoints(qd), kqdd = test::kdlJoints(qdd);
+    KDL::Jacobian kj(6);
+    jac.JntToJac(kq, kj);
+    const Jacobian& J = jacobian(*model, data, q);
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) ASSERT_NEAR(J(r, c), kj(static_cast<unsigned>(r), static_cast<unsigned>(c)), 1e-10);
+    KDL::JntArray ktau(6);
+    KDL::Wrenches w(chain.getNrOfSegments(), KDL::Wrench::Zero());
+    id.CartToJnt(kq, kqd, kqdd, w, ktau);
+    const JointVector& tau = inverseDynamics(*model, data, q, qd, qdd);
+    for (int i = 0; i < 6; ++i) ASSERT_NEAR(tau(i), ktau(static_cast<unsigned>(i)), 1e-9) << "joint " << i + 1;
+    KDL::JntSpaceInertiaMatrix km(6);
+    dyn.JntToMass(kq, km);
+    const JointMatrix& M = massMatrix(*model, data, q);
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) ASSERT_NEAR(M(r, c), km(static_cast<unsigned>(r), static_cast<unsigned>(c)), 1e-9);
+  }
+}
+
+TEST(UrdfModel, ExportedPumaLoadsBackWithTheSameKinematicsAndDynamics) {
+  const Puma560Model puma;
+  const std::string file = testing::TempDir() + "/puma560_roundtrip.urdf";
+  std::ofstream(file) << toUrdf(puma);
+  UrdfOptions options;
+  options.tip = "tool";
+  const std::unique_ptr<ManipulatorModel> back = loadUrdf(file, options);
+  ManipulatorData a(puma), b(*back);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-2, 2);
+  for (int trial = 0; trial < 200; ++trial) {
+    JointVector q(6), qd(6), qdd(6);
+    for (int i = 0; i < 6; ++i) {
+      q(i) = u(rng);
+      qd(i) = u(rng);
+      qdd(i) = u(rng);
+    }
+    ASSERT_LT((forwardKinematics(puma, a, q) - forwardKinematics(*back, b, q)).cwiseAbs().maxCoeff(), 1e-12);
+    const JointVector t1 = inverseDynamics(puma, a, q, qd, qdd), t2 = inverseDynamics(*back, b, q, qd, qdd);
+    for (int i = 0; i < 6; ++i) ASSERT_NEAR(t1(i), t2(i), 1e-9);
+  }
+}
+
+TEST(UrdfModel, BadFilesGiveClearErrors) {
+  auto message = [](const std::string& file, const UrdfOptions& o = UrdfOptions()) -> std::string {
+    try {
+      loadUrdf(file, o);
+    } catch (const UrdfError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(message(kData + "/missing.urdf"), kData + "/missing.urdf: cannot read the file");
+  EXPECT_NE(message(kData + "/bad_xml.urdf").find("not a valid URDF document"), std::string::npos);
+  EXPECT_NE(message(kData + "/floating.urdf").find("joint 'free' is floating or planar"), std::string::npos);
+  EXPECT_NE(message(kData + "/test_arm.urdf").find("the robot branches at link 'l3'; name the tip link"),
+            std::string::npos);
+  UrdfOptions unknownTip;
+  unknownTip.tip = "gripper";
+  EXPECT_NE(message(kData + "/test_arm.urdf", unknownTip).find("there is no link 'gripper'"), std::string::npos);
+  UrdfOptions dynamics;
+  dynamics.requireDynamics = true;
+  EXPECT_NE(message(kData + "/no_inertia.urdf", dynamics).find("link 'b' has no inertial data"), std::string::npos);
+  EXPECT_EQ(message(kData + "/no_inertia.urdf"), "no error") << "kinematics only is fine";
+}
+
+}  // namespace
+}  // namespace rp
