@@ -1,6 +1,6 @@
 // rp-model: kinematics and dynamics of a built-in robot from the command line, as JSON.
 //
-//   rp-model --robot puma560|wam4|wam7 COMMAND --q v1,v2,... [options]
+//   rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] COMMAND --q v1,v2,... [options]
 //
 // COMMAND: fk | jacobian | gravity | rnea --qd .. --qdd .. | inertia | fd --qd .. --tau .. |
 //          ik --pose p1,...,p16 [--seed ..] | urdf
@@ -85,7 +85,7 @@ int run(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
-      std::cout << "usage: rp-model --robot puma560|wam4|wam7 COMMAND --q v1,v2,... [--qd ..] [--qdd ..] [--tau ..]\n"
+      std::cout << "usage: rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] COMMAND --q v1,v2,... [--qd ..] [--qdd ..] [--tau ..]\n"
                    "                [--pose p1,...,p16] [--seed ..] [--motor-inertia] [--friction]\n"
                    "COMMAND: fk jacobian gravity rnea inertia fd ik urdf\n";
       return 0;
@@ -102,18 +102,23 @@ int run(int argc, char** argv) {
     }
   }
   const auto robotIt = opts.find("--robot");
-  if (robotIt == opts.end()) throw UsageError("missing --robot puma560|wam4|wam7");
+  if (robotIt == opts.end()) throw UsageError("missing --robot puma560|wam4|wam7|PATH.urdf");
   std::unique_ptr<ManipulatorModel> model;
   const std::string robot = robotIt->second;
   if (robot == "puma560") model = std::make_unique<Puma560Model>();
   else if (robot == "wam7") model = std::make_unique<WAM7Model>();
   else if (robot == "wam4") model = std::make_unique<WAM4Model>();
-  else if (robot.size() > 5 && robot.substr(robot.size() - 5) == ".urdf")
-    throw UsageError("loading URDF files is not supported yet (built-in robots: puma560, wam4, wam7)");
-  else throw UsageError("unknown robot '" + robot + "' (known: puma560, wam4, wam7)");
-  if (opts.count("--tip")) throw UsageError("--tip applies to URDF robots only");
+  else if (robot.size() > 5 && robot.substr(robot.size() - 5) == ".urdf") {
+    UrdfOptions urdf;
+    if (opts.count("--tip")) urdf.tip = opts.at("--tip");
+    urdf.requireDynamics = command == "gravity" || command == "rnea" || command == "inertia" || command == "fd";
+    model = loadUrdf(robot, urdf);
+  } else {
+    throw UsageError("unknown robot '" + robot + "' (known: puma560, wam4, wam7, or a .urdf file)");
+  }
+  if (opts.count("--tip") && robot.find(".urdf") == std::string::npos) throw UsageError("--tip applies to URDF robots only");
   for (const auto& [key, value] : opts) {
-    static const std::vector<std::string> known = {"--robot", "--q", "--qd", "--qdd", "--tau", "--pose", "--seed",
+    static const std::vector<std::string> known = {"--robot", "--tip", "--q", "--qd", "--qdd", "--tau", "--pose", "--seed",
                                                    "--motor-inertia", "--friction"};
     if (std::find(known.begin(), known.end(), key) == known.end()) throw UsageError("unknown option " + key);
     (void)value;

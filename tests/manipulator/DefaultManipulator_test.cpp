@@ -326,6 +326,24 @@ TEST_F(ManipulatorTest, CreatedByNameFromTheConfiguration) {
   om.deleteObject(follower);
 }
 
+TEST_F(ManipulatorTest, AnyArmFromAUrdfFileIsSimulatedAndHeld) {
+  RoboticPlatform::setConfiguration(Configuration::parse(
+      "[arm]\nclass UrdfManipulator\nurdf " RP_TEST_MODEL_DATA "/test_arm.urdf\ntip tool\nposition 0 0 100\n", "rp.cfg"));
+  ObjectManager om;
+  Manipulator* arm = om.createDerivedObject<Manipulator>("arm");
+  ASSERT_EQ(arm->getNumberOfJoints(), 6);
+  EXPECT_EQ(arm->getModel().getName(), "test_arm");
+  auto* loop = dynamic_cast<DefaultManipulator*>(arm);
+  ASSERT_NE(loop, nullptr);
+  ASSERT_TRUE(loop->waitForCycles(2000));
+  const JointVector q = arm->getJointPosition();
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(q(i), 0.0, 1e-6) << "held under gravity compensation, joint " << i + 1;
+  EXPECT_EQ(arm->getErrorCode(), 0) << arm->getErrorStatus().message;
+  om.deleteObject(arm);
+  RoboticPlatform::setConfiguration(Configuration::parse("[arm]\nclass UrdfManipulator\nurdf nosuchfile.urdf\n", "rp.cfg"));
+  EXPECT_THROW(om.createDerivedObject<Manipulator>("arm"), UrdfError);
+}
+
 // Counts the allocations the servo thread makes between two consecutive calculate() calls: the
 // whole cycle (simulation step, limit checks, state publication, log sampling, trajectory).
 class AllocationProbe : public ServoControl {

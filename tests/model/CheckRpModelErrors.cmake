@@ -7,7 +7,8 @@ set(cases
   "--robot;puma560;dance;--q;0,0,0,0,0,0"
   "--robot;puma560;ik;--pose;1,0,0,5,0,1,0,0,0,0,1,0,0,0,0,1"
   "--robot;puma560;ik;--pose;1,2,3"
-  "--robot;robot.urdf;fk;--q;0"
+  "--robot;missing.urdf;fk;--q;0"
+  "--robot;puma560;--tip;link3;fk;--q;0,0,0,0,0,0"
   "fk;--q;0,0,0,0,0,0")
 foreach(args IN LISTS cases)
   string(REPLACE ";" " " shown "${args}")

@@ -8,6 +8,7 @@
 #include "rp/manipulator/Manipulator.hpp"
 #include "rp/manipulator/ManipulatorSimulation.hpp"
 #include "rp/manipulator/Puma560.hpp"
+#include "rp/manipulator/UrdfManipulator.hpp"
 #include "rp/manipulator/WAM.hpp"
 #include "rp/trajectory/DefaultTrajectoryGenerator.hpp"
 #include "rp/trajectory/JerkLimitedProfile.hpp"

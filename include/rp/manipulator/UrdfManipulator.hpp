@@ -1,0 +1,29 @@
+#pragma once
+/// @file
+/// A manipulator described by a URDF file.
+
+#include "rp/manipulator/DefaultManipulator.hpp"
+#include "rp/model/UrdfModel.hpp"
+
+namespace rp {
+
+/// Any serial arm from a URDF file (see loadUrdf()), with a DefaultPositionControl and gravity
+/// compensation on, simulated from the file's inertias.
+///
+/// rp.cfg settings besides Table 1's: `urdf FILE` (relative paths are relative to the rp.cfg
+/// file's folder) and `tip LINK` (default: the last movable link of an unbranched chain).
+class UrdfManipulator : public DefaultManipulator {
+ public:
+  /// Creates the arm and starts its servo loop.
+  /// @param[in] name      object name (its rp.cfg section, if any); empty for an automatic name
+  /// @param[in] urdfFile  URDF path; rp.cfg's `urdf` setting overrides it
+  /// @param[in] tip       tip link; rp.cfg's `tip` setting overrides it
+  /// @throws UrdfError for a bad file; std::invalid_argument if no URDF file is given
+  explicit UrdfManipulator(const std::string& name = "", const std::string& urdfFile = "", const std::string& tip = "");
+  ~UrdfManipulator() override;
+  /// Declares `urdf` and `tip`.
+  /// @param[out] schema  schema to add to
+  static void declareSettings(SettingSchema& schema);
+};
+
+}  // namespace rp

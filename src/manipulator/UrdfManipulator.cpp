@@ -1,0 +1,51 @@
+// A manipulator described by a URDF file (rp/manipulator/UrdfManipulator.hpp).
+#include "rp/manipulator/UrdfManipulator.hpp"
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "rp/core/RoboticPlatform.hpp"
+#include "rp/core/TypeDatabase.hpp"
+
+namespace rp {
+
+namespace {
+std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, std::string file, std::string tip,
+                                          const Transform& base) {
+  if (const ConfigSection* section = RoboticPlatform::getConfiguration().findSection(name)) {
+    if (section->has("urdf")) {
+      file = section->getWord("urdf");
+      const std::filesystem::path p(file);
+      if (p.is_relative()) file = (std::filesystem::path(section->fileName()).parent_path() / p).string();
+    }
+    if (section->has("tip")) tip = section->getWord("tip");
+  }
+  if (file.empty()) throw std::invalid_argument("UrdfManipulator '" + name + "': no URDF file (rp.cfg setting 'urdf')");
+  UrdfOptions options;
+  options.tip = tip;
+  options.requireDynamics = true;
+  std::unique_ptr<ManipulatorModel> m = loadUrdf(file, options);
+  // Place the arm where the object stands: the object's pose times the URDF's own base frame.
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < m->getNumberOfJoints(); ++i) links.push_back(m->getLink(i));
+  return std::make_unique<ManipulatorModel>(m->getName(), links, Transform(base * m->getBaseTransform()),
+                                            m->getToolTransform());
+}
+}  // namespace
+
+UrdfManipulator::UrdfManipulator(const std::string& name, const std::string& urdfFile, const std::string& tip)
+    : DefaultManipulator(name, [name, urdfFile, tip](const Transform& base) { return loadFor(name, urdfFile, tip, base); }) {
+  startControlLoop();
+}
+
+UrdfManipulator::~UrdfManipulator() { stopControlLoop(); }
+
+void UrdfManipulator::declareSettings(SettingSchema& schema) {
+  DefaultManipulator::declareSettings(schema);
+  schema.addWord("urdf", "URDF file of the arm");
+  schema.addWord("tip", "last link of the chain");
+}
+
+}  // namespace rp
+
+RP_REGISTER_CLASS_AS(rp::UrdfManipulator, "UrdfManipulator");
