@@ -29,11 +29,15 @@ void Manipulator::disconnectGenerator(TrajectoryGenerator& generator) {
   v.erase(std::remove(v.begin(), v.end(), this), v.end());
 }
 
-ServoControl::~ServoControl() {
+ServoControl::~ServoControl() { releaseFromManipulator(); }
+
+void ServoControl::releaseFromManipulator() {
   if (d_manipulator != nullptr) d_manipulator->releaseServoControl(*this);
 }
 
-TrajectoryGenerator::~TrajectoryGenerator() {
+TrajectoryGenerator::~TrajectoryGenerator() { releaseFromManipulators(); }
+
+void TrajectoryGenerator::releaseFromManipulators() {
   for (Manipulator* m : getManipulators()) m->releaseTrajectoryGenerator(*this);
 }
 

@@ -35,6 +35,7 @@ class ManipulatorTest : public ::testing::Test {
 class StepGenerator : public TrajectoryGenerator {
  public:
   StepGenerator(const JointVector& target, double start) : target_(target), start_(start) {}
+  ~StepGenerator() override { releaseFromManipulators(); }
   bool getCurrentSetpoint(double time, Setpoint& sp) override {
     if (time < start_) return false;
     sp.position = target_;
@@ -51,6 +52,7 @@ class StepGenerator : public TrajectoryGenerator {
 class Probe : public ServoControl {
  public:
   explicit Probe(ServoControl& inner, std::uint64_t recordAt = 0) : inner_(inner), recordAt_(recordAt) {}
+  ~Probe() override { releaseFromManipulator(); }
   // Track how far each joint goes past `target` (for steps in the positive direction).
   void trackOvershoot(const JointVector& target) {
     target_ = target;
@@ -64,7 +66,8 @@ class Probe : public ServoControl {
   void calculate() override {
     ++cycles_;
     const JointVector q = d_manipulator->getJointPosition();
-    if (target_.size() == q.size()) overshoot_ = overshoot_.cwiseMax(q - target_);
+    // Read by the test thread once recorded() is true: stop writing then.
+    if (target_.size() == q.size() && cycles_ <= recordAt_) overshoot_ = overshoot_.cwiseMax(q - target_);
     if (cycles_ == recordAt_) {
       recorded_ = q;
       recordedFlag_.store(true);
@@ -127,6 +130,7 @@ TEST_F(ManipulatorTest, StepResponseSettlesWithLittleOvershoot) {
 class ConstantTorque : public ServoControl {
  public:
   ConstantTorque(int joint, double torque) : joint_(joint), torque_(torque) {}
+  ~ConstantTorque() override { releaseFromManipulator(); }
   void calculate() override {
     Vector<6> t;
     t(joint_) = torque_;
@@ -168,6 +172,7 @@ TEST_F(ManipulatorTest, VelocityLimitViolationShutsTheSystemDown) {
 class RampGenerator : public TrajectoryGenerator {
  public:
   RampGenerator(const JointVector& start, int joint, double speed) : start_(start), joint_(joint), speed_(speed) {}
+  ~RampGenerator() override { releaseFromManipulators(); }
   bool getCurrentSetpoint(double time, Setpoint& sp) override {
     if (t0_ < 0) t0_ = time;  // the shared simulated clock does not start at 0
     sp.position = start_;
@@ -202,6 +207,7 @@ TEST_F(ManipulatorTest, ViolationIsDetectedInTheCycleItHappens) {
   ConstantTorque tooMuch(0, 150.0);  // joint 1 limit 100 N m
   Probe probe(tooMuch);
   struct Counter : ServoControl {
+    ~Counter() override { releaseFromManipulator(); }
     ServoControl* inner = nullptr;
     std::atomic<int> calls{0};
     void calculate() override {
@@ -349,6 +355,7 @@ TEST_F(ManipulatorTest, AnyArmFromAUrdfFileIsSimulatedAndHeld) {
 class AllocationProbe : public ServoControl {
  public:
   explicit AllocationProbe(ServoControl& inner) : inner_(inner) {}
+  ~AllocationProbe() override { releaseFromManipulator(); }
   void attach(Manipulator& m) override {
     ServoControl::attach(m);
     if (inner_.getManipulator() != &m) inner_.attach(m);
@@ -360,9 +367,10 @@ class AllocationProbe : public ServoControl {
     inner_.calculate();
     last_ = test::allocationCount();
     if (cycles_ > 2) allocations_ += last_ - now;
+    total_.store(allocations_);
     cycleCount_.store(cycles_);
   }
-  std::size_t allocations() const { return allocations_; }
+  std::size_t allocations() const { return total_.load(); }
   std::uint64_t cycles() const { return cycleCount_.load(); }
 
  private:
@@ -370,6 +378,7 @@ class AllocationProbe : public ServoControl {
   std::size_t last_ = 0, allocations_ = 0;
   std::uint64_t cycles_ = 0;
   std::atomic<std::uint64_t> cycleCount_{0};
+  std::atomic<std::size_t> total_{0};  // allocations_, published for the test thread
 };
 
 TEST_F(ManipulatorTest, TheServoCycleDoesNotAllocate) {

@@ -28,6 +28,8 @@ class DefaultPositionControl : public ServoControl {
   /// Creates the control; gains are set when it is attached to a manipulator.
   /// @param[in] name  object name; empty for an automatic name
   explicit DefaultPositionControl(const std::string& name = "");
+  /// Stops the manipulator from using this control first.
+  ~DefaultPositionControl() override { releaseFromManipulator(); }
 
   /// Attaches to `manipulator` and sets the default gains for its model (unless set before).
   /// @param[in] manipulator  the manipulator to drive

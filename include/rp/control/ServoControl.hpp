@@ -57,6 +57,12 @@ class ServoControl : public FunctionalObject {
   Manipulator* getManipulator() const { return d_manipulator; }
 
  protected:
+  /// Stops the manipulator from using this control (it switches back to its default control)
+  /// and returns once no servo cycle runs it. A derived class should call this first thing in
+  /// its destructor (the base destructor calls it too, but by then the derived part is gone).
+  /// Real-time safe: no.
+  void releaseFromManipulator();
+
   /// The manipulator this control drives (the paper's name, as Figure 22 uses it).
   Manipulator* d_manipulator = nullptr;
 

@@ -34,6 +34,11 @@ class DefaultTrajectoryGenerator : public QueueTrajectoryGenerator {
   /// Creates an empty generator.
   /// @param[in] name  object name; empty for an automatic name
   explicit DefaultTrajectoryGenerator(const std::string& name = "") : QueueTrajectoryGenerator(name) {}
+  /// Finishes the queue (see QueueTrajectoryGenerator), then disconnects from the manipulators.
+  ~DefaultTrajectoryGenerator() override {
+    waitUntilDone();
+    releaseFromManipulators();
+  }
 
   /// Checks the number of joints, then connects.
   /// @param[in] manipulator  the manipulator that will follow this generator

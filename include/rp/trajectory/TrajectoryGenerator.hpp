@@ -54,6 +54,13 @@ class TrajectoryGenerator : public FunctionalObject {
   /// The manipulators connected to this generator. Real-time safe: no.
   std::vector<Manipulator*> getManipulators() const;
 
+ protected:
+  /// Disconnects from every manipulator and returns once no servo cycle runs this generator.
+  /// A derived class whose getCurrentSetpoint() may run while it is destroyed must call this
+  /// first thing in its destructor (the base destructor calls it too, but by then the derived
+  /// part is gone). Real-time safe: no.
+  void releaseFromManipulators();
+
  private:
   friend class Manipulator;
   mutable std::mutex manipulatorsMutex_;
