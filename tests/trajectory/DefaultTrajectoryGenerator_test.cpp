@@ -4,6 +4,8 @@
 #include <cmath>
 #include <chrono>
 #include <numbers>
+#include <random>
+#include <vector>
 #include <thread>
 
 #include "AllocationCounter.hpp"
@@ -115,6 +117,89 @@ TEST_F(TrajectoryTest, SetpointEvaluationDoesNotAllocateAndStaysWithinLimits) {
   EXPECT_TRUE(tragen.isDone());
   for (int k = 0; k < 6; ++k) EXPECT_NEAR(sp.position(k), target(k) * kDeg, 1e-12);
   puma.clearTrajectoryGenerator();
+  clock.resume();
+}
+
+}  // namespace
+}  // namespace rp
+
+namespace rp {
+namespace {
+
+// Seeded random multi-segment sequences evaluated the way the servo loop does (1 kHz): the
+// setpoints stay within the planning limits, are continuous in position and velocity across
+// segment boundaries (acceleration changes by at most jerk * dt), end exactly at each target, and
+// each segment lasts the profile's time-optimal duration.
+TEST_F(TrajectoryTest, RandomMultiSegmentSequencesRespectLimitsAndContinuity) {
+  Puma560 puma;
+  SimulatedClock& clock = dynamic_cast<SimulatedClock&>(RoboticPlatform::getDefaultClock());
+  clock.pause();
+  while (puma.getCycleCount() < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const ManipulatorModel& model = puma.getModel();
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  const int sequences = 100;
+#else
+  const int sequences = 3000;
+#endif
+  std::mt19937_64 rng(4242);
+  const double dt = 1e-3, f = 0.8;
+  double time = 5000;
+  int segments = 0;
+  for (int s = 0; s < sequences; ++s) {
+    DefaultTrajectoryGenerator<6> tragen;
+    puma.setTrajectoryGenerator(tragen);
+    const int count = 2 + static_cast<int>(rng() % 4);
+    std::vector<JointVector> targets;
+    double expectedDuration = 0;
+    JointVector from = tragen.getLastTarget();
+    for (int k = 0; k < count; ++k) {
+      JointVector q(6);
+      for (int i = 0; i < 6; ++i) {
+        q(i) = std::uniform_real_distribution<double>(0.9 * model.getPositionMin()(i), 0.9 * model.getPositionMax()(i))(rng);
+      }
+      tragen.moveRadians(q);
+      // The analytic duration of the synchronised line from `from` to `q`.
+      double vs = INFINITY, as = INFINITY, js = INFINITY;
+      for (int i = 0; i < 6; ++i) {
+        const double d = std::abs(q(i) - from(i));
+        vs = std::min(vs, f * model.getVelocityLimit()(i) / d);
+        as = std::min(as, f * model.getAccelerationLimit()(i) / d);
+        js = std::min(js, f * model.getJerkLimit()(i) / d);
+      }
+      expectedDuration += JerkLimitedProfile(1.0, vs, as, js).getDuration();
+      targets.push_back(q);
+      from = q;
+      ++segments;
+    }
+    Setpoint sp, prev;
+    sp.position = sp.velocity = sp.acceleration = JointVector(6);
+    ASSERT_TRUE(tragen.getCurrentSetpoint(time, prev));
+    double t = time;
+    int steps = 0;
+    while (!tragen.isDone()) {
+      t += dt;
+      ASSERT_TRUE(tragen.getCurrentSetpoint(t, sp));
+      for (int i = 0; i < 6; ++i) {
+        ASSERT_LE(std::abs(sp.velocity(i)), f * model.getVelocityLimit()(i) * (1 + 1e-9));
+        ASSERT_LE(std::abs(sp.acceleration(i)), f * model.getAccelerationLimit()(i) * (1 + 1e-9));
+        ASSERT_LE(std::abs(sp.acceleration(i) - prev.acceleration(i)), f * model.getJerkLimit()(i) * dt * (1 + 1e-6) + 1e-12);
+        ASSERT_LE(std::abs(sp.velocity(i) - prev.velocity(i)), f * model.getAccelerationLimit()(i) * dt * (1 + 1e-6) + 1e-12);
+        ASSERT_LE(std::abs(sp.position(i) - prev.position(i)), f * model.getVelocityLimit()(i) * dt * (1 + 1e-6) + 1e-12);
+      }
+      prev = sp;
+      ASSERT_LT(++steps, 1000000);
+    }
+    // Done within one sample of the analytic total, at rest exactly on the last target.
+    EXPECT_NEAR(t - time, expectedDuration, dt + 1e-9);
+    ASSERT_TRUE(tragen.getCurrentSetpoint(t + dt, sp));
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_NEAR(sp.position(i), targets.back()(i), 1e-12);
+      EXPECT_EQ(sp.velocity(i), 0.0);
+    }
+    time = t + 10;
+    puma.clearTrajectoryGenerator();
+  }
+  RecordProperty("segments", segments);
   clock.resume();
 }
 
