@@ -1,13 +1,16 @@
 // Comparison of simulation and implementation: the paper's Figure 23.
 //
 // One trajectory generator feeds the same setpoints to two Puma 560 objects; the second is in
-// simulation mode. Without robot hardware both are simulated here, and the program prints the
-// largest difference between the two arms' joint positions over the motion.
+// simulation mode. Without robot hardware both are simulated, and the program prints the largest
+// difference between the two arms' joint positions over the motion (0 when both are simulated).
 //
 // Run: build/bin/sim_vs_real [-simclock] [-log sim_vs_real.csv]
 //
 // Changes from the paper's Figure 23:
 // - `int main(int argc, char* argv[])` instead of `void main`;
+// - the first robot is named "puma", so that an rp.cfg section can put it behind a hardware
+//   server: `[puma]`, `class Puma560`, `simulationMode off`, `hwserver cell` with
+//   `rp-hwserver -name cell -board puma560` running (a Puma 560 wired to an I/O board);
 // - after queueing the two motions the program follows them to the end and prints the largest
 //   joint-position difference between the arms (the paper's program only queued them).
 #include "RoboticPlatform.hpp"
@@ -23,7 +26,7 @@ int main(int argc, char* argv[]) {
   RoboticPlatform::init(argc, argv);
 
   // Create the robot objects
-  Puma560 puma;
+  Puma560 puma("puma");  // named, so that rp.cfg can wire it to hardware
   Puma560 pumaSimulated;
 
   // The second robot is simulated

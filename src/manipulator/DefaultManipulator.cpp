@@ -11,6 +11,7 @@
 #include "rp/control/ServoControl.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/model/Dynamics.hpp"
+#include "rp/io/HwServerIoBoard.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/rt/Clock.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
@@ -58,10 +59,15 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   model_ = modelFactory(getTransform());
   if (!model_) throw std::invalid_argument("DefaultManipulator '" + getName() + "': no model");
   if (!isSimulationModeOn()) {
-    throw std::runtime_error("manipulator '" + getName() +
-                             "': simulation mode is off but no hardware is configured for it; switch "
-                             "simulation on (-sim, or 'simulationMode on' in rp.cfg) or configure a hardware "
-                             "server");
+    const ConfigSection* section = configSection();
+    if (section == nullptr || !section->has("hwserver")) {
+      throw std::runtime_error("manipulator '" + getName() +
+                               "': simulation mode is off but no hardware is configured for it; switch "
+                               "simulation on (-sim, or 'simulationMode on' in rp.cfg) or name a hardware "
+                               "server (rp.cfg 'hwserver NAME')");
+    }
+    if (section->has("countsPerRadian")) countsPerRadian_ = section->getNumbers("countsPerRadian").at(0);
+    board_ = std::make_unique<HwServerIoBoard>(section->getWord("hwserver"));  // throws IoException if absent
   }
   const int n = model_->getNumberOfJoints();
   data_ = std::make_unique<ManipulatorData>(*model_);
@@ -70,6 +76,12 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   for (JointVector* v : {&q_, &qd_, &tau_, &gravity_, &hold_}) v->setZero(n);
   for (JointVector* v : {&setpoint_.position, &setpoint_.velocity, &setpoint_.acceleration}) v->setZero(n);
   q_ = sim_->getPosition();
+  if (board_) {
+    velocity_ = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
+    if (!readHardware()) {
+      throw std::runtime_error("manipulator '" + getName() + "': cannot read the joints: " + board_->lastError());
+    }
+  }
   hold_ = q_;
   setpoint_.position = q_;
   std::snprintf(nameBuffer_, sizeof nameBuffer_, "%s", getName().c_str());
@@ -271,6 +283,40 @@ bool DefaultManipulator::waitForCycles(std::uint64_t cycles, double timeoutSecon
   return true;
 }
 
+void DefaultManipulator::declareSettings(SettingSchema& schema) {
+  Manipulator::declareSettings(schema);
+  schema.addWord("hwserver", "name of the hardware server the arm is wired to");
+  schema.addNumbers("countsPerRadian", 1, "counts/rad", "encoder counts per joint radian");
+}
+
+bool DefaultManipulator::readHardware() {
+  for (int i = 0; i < q_.size(); ++i) {
+    std::int64_t counts = 0;
+    if (board_->readEncoder(i, counts) != IoStatus::kOk) return false;
+    q_(i) = static_cast<double>(counts) / countsPerRadian_;
+  }
+  qd_ = velocity_->differentiate(q_);
+  return true;
+}
+
+void DefaultManipulator::writeHardware() {
+  for (int i = 0; i < tau_.size(); ++i) {
+    const double gain = model_->getTorqueLimit()(i) / 10.0;  // amplifier: 10 V is the torque limit
+    if (board_->writeAnalogOutput(i, tau_(i) / gain) != IoStatus::kOk) return ioFailure("writing the torques", i);
+  }
+  if (board_->writeDigitalOutput(0, power_) != IoStatus::kOk) ioFailure("switching the amplifiers", 0);
+}
+
+void DefaultManipulator::ioFailure(const char* what, int line) {
+  // Real-time safe: formats into a member buffer. The arm cannot be controlled: shut down.
+  std::snprintf(errorBuffer_, sizeof errorBuffer_, "%.60s: hardware failure %.40s (line %d): %.120s", nameBuffer_, what, line,
+                board_->lastError());
+  setError(2, errorBuffer_);
+  power_ = false;
+  if (shutdownPhase_.load() != 2) shutdownPhase_.store(2);
+  requestSystemShutdown(errorBuffer_);
+}
+
 void DefaultManipulator::enterControl() {
   servoThread_.store(std::this_thread::get_id());
   simulatedClock_ = dynamic_cast<SimulatedClock*>(&getClock());
@@ -297,14 +343,18 @@ void DefaultManipulator::control() {
   if (wantPower != power_ && phase == 0) {
     power_ = wantPower;
     sim_->setBrakes(!power_);
-    hold_ = sim_->getPosition();
+    hold_ = board_ ? q_ : sim_->getPosition();
     if (power_) activeControl_ = nullptr;  // activate() again below
   }
-  Vector<6> wrench = sim_->getExternalWrench();
-  wrench_->read(wrench);
-  sim_->setExternalWrench(wrench);
-  q_ = sim_->getPosition();
-  qd_ = sim_->getVelocity();
+  if (board_) {
+    if (!readHardware()) ioFailure("reading the encoders", 0);
+  } else {
+    Vector<6> wrench = sim_->getExternalWrench();
+    wrench_->read(wrench);
+    sim_->setExternalWrench(wrench);
+    q_ = sim_->getPosition();
+    qd_ = sim_->getVelocity();
+  }
 
   // 2. The setpoint: the trajectory generator's, or hold.
   const bool zeroG = zeroGravity_.load(std::memory_order_relaxed);
@@ -364,7 +414,11 @@ void DefaultManipulator::control() {
 
   // 5. Output: no torque without power; the simulation integrates the dynamics.
   if (!power_) tau_.setZero();
-  sim_->step(tau_, dt);
+  if (board_) {
+    writeHardware();
+  } else {
+    sim_->step(tau_, dt);
+  }
   (void)n;
 
   // 6. State for other threads (log samples are taken by the ControlProgram after control()).

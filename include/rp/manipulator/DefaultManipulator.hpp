@@ -9,6 +9,8 @@
 #include <thread>
 
 #include "rp/control/DefaultPositionControl.hpp"
+#include "rp/io/IoBoard.hpp"
+#include "rp/math/Differentiator.hpp"
 #include "rp/manipulator/Manipulator.hpp"
 #include "rp/manipulator/ManipulatorSimulation.hpp"
 #include "rp/rt/ControlProgram.hpp"
@@ -37,6 +39,13 @@ class SimulatedClock;
 ///
 /// The arm power is on when the loop starts, holding the position the arm is in. In simulation
 /// mode the arm starts at rest at the model's home position.
+///
+/// Hardware (simulation mode off): the arm is reached through a hardware server named by rp.cfg's
+/// `hwserver NAME` (see rp-hwserver): joint j's angle is encoder j's count divided by
+/// `countsPerRadian` (default 20000), its velocity a filtered backward difference, its torque goes
+/// out as analog output j in volts (torque / gain, gain = torque limit / 10 V), and digital output 0
+/// enables the amplifiers (power). A failed read or write sets the error status and requests a
+/// system shutdown.
 class DefaultManipulator : public Manipulator, public ControlProgram {
  public:
   /// Makes the model once the object's pose (rp.cfg `position`/`orientation`) is known.
@@ -50,6 +59,12 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   DefaultManipulator(const std::string& name, const ModelFactory& modelFactory);
   /// Stops the servo loop.
   ~DefaultManipulator() override;
+
+  /// Declares `hwserver` and `countsPerRadian`.
+  /// @param[out] schema  schema to add to
+  static void declareSettings(SettingSchema& schema);
+  /// Whether the arm is reached through a hardware server (simulation mode off).
+  bool usesHardware() const { return board_ != nullptr; }
 
   const ManipulatorModel& getModel() const override { return *model_; }
   double getServoPeriod() const override { return getPeriod(); }
@@ -128,12 +143,18 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void checkLimits();
   void violation(const char* what, int joint, double value, double limit, const char* unit);
   void publish();
+  bool readHardware();
+  void writeHardware();
+  void ioFailure(const char* what, int line);
 
   std::unique_ptr<ManipulatorModel> model_;
   std::unique_ptr<ManipulatorData> data_;  // servo thread's
   std::unique_ptr<ManipulatorSimulation> sim_;
   std::unique_ptr<DefaultPositionControl> defaultControl_;
   std::unique_ptr<WrenchBox> wrench_;
+  std::unique_ptr<IoBoard> board_;  // hardware server client, when simulation mode is off
+  double countsPerRadian_ = 20000;
+  std::unique_ptr<Differentiator<JointVector>> velocity_;
 
   std::atomic<ServoControl*> servoControl_{nullptr};
   ServoControl* activeControl_ = nullptr;
