@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Figure 23 with one Puma behind a hardware server (rp-hwserver -board puma560: a Puma 560 wired to
+# an I/O board) and the other simulated: the program completes and prints the largest difference.
+set -euo pipefail
+hwserver=$1 program=$2 work=$3
+name="svr-$$"
+mkdir -p "$work"
+printf '[puma]\nclass Puma560\nsimulationMode off\nhwserver %s\n' "$name" > "$work/rp.cfg"
+"$hwserver" -name "$name" -rate 1000 -board puma560 -duration 120 > "$work/hwserver.log" 2>&1 &
+server=$!
+trap 'kill $server 2>/dev/null || true; wait $server 2>/dev/null || true' EXIT
+for _ in $(seq 1 100); do grep -q "serving" "$work/hwserver.log" && break; sleep 0.1; done
+timeout 100 "$program" -nogui -config "$work/rp.cfg"
