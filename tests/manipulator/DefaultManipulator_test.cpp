@@ -7,6 +7,7 @@
 #include <cmath>
 #include <chrono>
 #include <numbers>
+#include <random>
 #include <thread>
 
 #include "AllocationCounter.hpp"
@@ -95,6 +96,32 @@ TEST_F(ManipulatorTest, GravityCompensationHoldsTheArmAtRest) {
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(q(i), home(i), 1e-6) << "joint " << i + 1;
   EXPECT_TRUE(puma.isArmPowerOn());
   EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, GravityCompensationAloneHoldsRandomPosesAtRest) {
+  // Zero-gravity mode outputs only the model's gravity torque: at rest in any pose the arm must
+  // stay put (the simulation uses the same model, so the only drift is rounding).
+  Puma560 puma;
+  DefaultTrajectoryGenerator<6> tragen;
+  puma.setTrajectoryGenerator(tragen);
+  std::mt19937_64 rng(8);
+  const ManipulatorModel& model = puma.getModel();
+  for (int trial = 0; trial < 4; ++trial) {
+    JointVector q(6);
+    for (int i = 0; i < 6; ++i) {
+      q(i) = std::uniform_real_distribution<double>(0.7 * model.getPositionMin()(i), 0.7 * model.getPositionMax()(i))(rng);
+    }
+    tragen.moveRadians(q);
+    tragen.stop(1.0);
+    puma.setZeroGravityModeOn();
+    ASSERT_TRUE(puma.waitForCycles(100));
+    const JointVector start = puma.getJointPosition();
+    ASSERT_TRUE(puma.waitForCycles(2000));
+    const JointVector end = puma.getJointPosition();
+    for (int i = 0; i < 6; ++i) EXPECT_NEAR(end(i), start(i), 1e-6) << "pose " << trial << ", joint " << i + 1;
+    puma.setZeroGravityModeOff();
+    EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+  }
 }
 
 TEST_F(ManipulatorTest, StepResponseSettlesWithLittleOvershoot) {
