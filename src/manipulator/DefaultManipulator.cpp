@@ -18,32 +18,44 @@
 
 namespace rp {
 
-// The external wrench crosses from user threads to the servo thread through a sequence lock:
-// writers (serialised by a mutex) never block the reader, which retries a torn read.
+// External wrenches (slot 0: the end-effector's; slot k: link k's, with its point) cross from
+// user threads to the servo thread through a sequence lock: writers (serialised by a mutex) never
+// block the reader, which retries a torn read and skips the copy when nothing changed.
 struct DefaultManipulator::WrenchBox {
+  static constexpr int kSlot = 9;  // point (3), then force and moment (6)
+  static constexpr int kSize = kSlot * (kMaxJoints + 1);
   std::mutex writerMutex;
   std::atomic<unsigned> sequence{0};
-  std::atomic<double> values[6] = {};
+  std::atomic<double> values[kSize] = {};
+  // Servo thread's: the last consistent copy and the sequence it was read at.
+  double snapshot[kSize] = {};
+  unsigned lastRead = 0;
 
-  void write(const Vector<6>& w) {
+  void write(int slot, const Vector<3>& point, const Vector<6>& w) {
     std::lock_guard<std::mutex> lock(writerMutex);
     sequence.fetch_add(1, std::memory_order_acq_rel);
-    for (int i = 0; i < 6; ++i) values[i].store(w(i), std::memory_order_relaxed);
+    std::atomic<double>* v = values + slot * kSlot;
+    for (int i = 0; i < 3; ++i) v[i].store(point(i), std::memory_order_relaxed);
+    for (int i = 0; i < 6; ++i) v[3 + i].store(w(i), std::memory_order_relaxed);
     sequence.fetch_add(1, std::memory_order_release);
   }
-  // Real-time safe: lock-free; gives up (keeping `out`) after a few torn reads.
-  void read(Vector<6>& out) const {
+  // Real-time safe: lock-free. Returns true with a new snapshot (the first `slots` slots) when a
+  // write happened since the last read; gives up (keeping the old one) after a few torn reads.
+  bool read(int slots) {
+    if (sequence.load(std::memory_order_acquire) == lastRead) return false;
     for (int attempt = 0; attempt < 8; ++attempt) {
       const unsigned before = sequence.load(std::memory_order_acquire);
       if (before & 1u) continue;
-      Vector<6> w;
+      double copy[kSize];
       // Acquire loads keep the second read of the sequence after the values.
-      for (int i = 0; i < 6; ++i) w(i) = values[i].load(std::memory_order_acquire);
+      for (int i = 0; i < slots * kSlot; ++i) copy[i] = values[i].load(std::memory_order_acquire);
       if (sequence.load(std::memory_order_acquire) == before) {
-        out = w;
-        return;
+        std::copy(copy, copy + slots * kSlot, snapshot);
+        lastRead = before;
+        return true;
       }
     }
+    return false;
   }
 };
 
@@ -246,7 +258,16 @@ void DefaultManipulator::setZeroGravityModeOff() {
   zeroGravity_.store(false);
 }
 
-void DefaultManipulator::applyExternalWrench(const Vector<6>& wrench) { wrench_->write(wrench); }
+void DefaultManipulator::applyExternalWrench(const Vector<6>& wrench) { wrench_->write(0, Vector<3>(), wrench); }
+
+void DefaultManipulator::applyExternalWrench(int link, const Vector<3>& point, const Vector<6>& wrench) {
+  const int n = model_->getNumberOfJoints();
+  if (link < 1 || link > n) {
+    throw std::out_of_range(getName() + ": applyExternalWrench: link " + std::to_string(link) + " is not in 1.." +
+                            std::to_string(n));
+  }
+  wrench_->write(link, point, wrench);
+}
 
 void DefaultManipulator::startShutdown() {
   RoboticObject::startShutdown();
@@ -349,9 +370,20 @@ void DefaultManipulator::control() {
   if (board_) {
     if (!readHardware()) ioFailure("reading the encoders", 0);
   } else {
-    Vector<6> wrench = sim_->getExternalWrench();
-    wrench_->read(wrench);
-    sim_->setExternalWrench(wrench);
+    if (wrench_->read(n + 1)) {
+      Vector<3> point;
+      Vector<6> wrench;
+      for (int k = 0; k <= n; ++k) {
+        const double* slot = wrench_->snapshot + k * WrenchBox::kSlot;
+        for (int i = 0; i < 3; ++i) point(i) = slot[i];
+        for (int i = 0; i < 6; ++i) wrench(i) = slot[3 + i];
+        if (k == 0) {
+          sim_->setExternalWrench(wrench);
+        } else {
+          sim_->setExternalLinkWrench(k, point, wrench);
+        }
+      }
+    }
     q_ = sim_->getPosition();
     qd_ = sim_->getVelocity();
   }
@@ -419,7 +451,6 @@ void DefaultManipulator::control() {
   } else {
     sim_->step(tau_, dt);
   }
-  (void)n;
 
   // 6. State for other threads (log samples are taken by the ControlProgram after control()).
   publish();

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace rp {
 
@@ -34,12 +36,7 @@ void ManipulatorSimulation::step(const JointVector& tau, double dt) {
     lastSubsteps_ = 1;
     return;
   }
-  // External wrench: J^T F, constant over the step.
-  if (wrench_.squaredNorm() > 0) {
-    endEffectorForceToJointTorque(model_, data_, q_, wrench_, tauExt_, ReferenceFrame::Base);
-  } else {
-    tauExt_.setZero();
-  }
+  externalTorque();  // constant over the step
   // Sub-steps while a joint is at a stop: the stop's stiffness k against the joint's inertia
   // (at least its armature) gives the frequency to resolve.
   bool atStop = false;
@@ -55,6 +52,47 @@ void ManipulatorSimulation::step(const JointVector& tau, double dt) {
   lastSubsteps_ = substeps;
   const double h = dt / substeps;
   for (int s = 0; s < substeps; ++s) integrate(tau, h);
+}
+
+void ManipulatorSimulation::setExternalLinkWrench(int link, const Vector<3>& point, const Vector<6>& wrench) {
+  const int n = model_.getNumberOfJoints();
+  if (link < 1 || link > n) {
+    throw std::out_of_range("ManipulatorSimulation::setExternalLinkWrench: link " + std::to_string(link) +
+                            " is not in 1.." + std::to_string(n));
+  }
+  const auto k = static_cast<std::size_t>(link - 1);
+  const bool was = linkWrench_[k].squaredNorm() > 0;
+  linkPoint_[k] = point;
+  linkWrench_[k] = wrench;
+  linkWrenches_ += (wrench.squaredNorm() > 0 ? 1 : 0) - (was ? 1 : 0);
+}
+
+void ManipulatorSimulation::clearExternalLinkWrenches() {
+  for (Vector<6>& w : linkWrench_) w.setZero();
+  linkWrenches_ = 0;
+}
+
+void ManipulatorSimulation::externalTorque() {
+  tauExt_.setZero();
+  if (linkWrenches_ == 0 && !(wrench_.squaredNorm() > 0)) return;
+  // One Jacobian J at the end-effector's origin e (it also computes the link frames). For a point
+  // p moving with joints 1..k, column j <= k of its Jacobian is (Jv_j + Jw_j x (p - e), Jw_j), so
+  // that column's torque is Jv_j . f + Jw_j . (m + (p - e) x f): the wrench moved to e.
+  const Jacobian& J = jacobian(model_, data_, q_, ReferenceFrame::Base);
+  if (wrench_.squaredNorm() > 0) tauExt_.noalias() = J.transpose() * wrench_;
+  if (linkWrenches_ == 0) return;
+  const Eigen::Vector3d e = data_.endEffector.topRightCorner<3, 1>();
+  const int n = model_.getNumberOfJoints();
+  for (int k = 0; k < n; ++k) {
+    const Vector<6>& w = linkWrench_[static_cast<std::size_t>(k)];
+    if (!(w.squaredNorm() > 0)) continue;
+    const Transform& T = data_.linkTransforms[static_cast<std::size_t>(k)];
+    const Eigen::Vector3d p =
+        T.topLeftCorner<3, 3>() * Eigen::Vector3d(linkPoint_[static_cast<std::size_t>(k)]) + T.topRightCorner<3, 1>();
+    const Eigen::Vector3d f = w.head<3>();
+    const Eigen::Vector3d m = w.tail<3>() + (p - e).cross(f);
+    for (int j = 0; j <= k; ++j) tauExt_(j) += J.col(j).head<3>().dot(f) + J.col(j).tail<3>().dot(m);
+  }
 }
 
 void ManipulatorSimulation::integrate(const JointVector& tau, double h) {

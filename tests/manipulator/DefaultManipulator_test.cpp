@@ -11,26 +11,14 @@
 #include <thread>
 
 #include "AllocationCounter.hpp"
+#include "SimulatedArmTest.hpp"
 #include "rp/RoboticPlatform.hpp"
 
 namespace rp {
 namespace {
 
-SimulatedClock& simClock() {
-  RoboticPlatform::useSimulatedClock();
-  return dynamic_cast<SimulatedClock&>(RoboticPlatform::getDefaultClock());
-}
-
-class ManipulatorTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    RoboticPlatform::setConfiguration(Configuration());
-    RoboticPlatform::setSimulationModeOn();
-    ObjectManager::resetShutdown();
-    simClock().resume();
-  }
-  void TearDown() override { simClock().resume(); }
-};
+using test::simClock;
+using ManipulatorTest = test::SimulatedArmTest;
 
 // A trajectory generator that gives a constant target (a step) once `start` has passed.
 class StepGenerator : public TrajectoryGenerator {
@@ -419,6 +407,11 @@ TEST_F(ManipulatorTest, TheServoCycleDoesNotAllocate) {
   Vector<6> push;
   push(2) = 5.0;
   puma.applyExternalWrench(push);
+  while (probe.cycles() < 1000) puma.waitForCycles(100);
+  // A wrench on a link too: the servo thread copies it in and the simulation applies it.
+  Vector<3> point;
+  point(0) = -0.2;
+  puma.applyExternalWrench(2, point, push);
   while (probe.cycles() < 2000) puma.waitForCycles(100);
   simClock().pause();
   EXPECT_EQ(probe.allocations(), 0u);

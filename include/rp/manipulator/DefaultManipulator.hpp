@@ -100,6 +100,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   bool isZeroGravityModeOn() const override { return zeroGravity_.load(); }
 
   void applyExternalWrench(const Vector<6>& wrench) override;
+  void applyExternalWrench(int link, const Vector<3>& point, const Vector<6>& wrench) override;
   void releaseServoControl(ServoControl& control) override;
   void releaseTrajectoryGenerator(TrajectoryGenerator& generator) override;
 

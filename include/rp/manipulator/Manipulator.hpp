@@ -133,8 +133,24 @@ class Manipulator : public PhysicalObject {
   /// coordinates (force [N], moment [N m] about the end-effector origin), until changed.
   /// @param[in] wrench  (6 x 1); zero for none
   virtual void applyExternalWrench(const Vector<6>& wrench) = 0;
-  /// Removes the external wrench.
+  /// Removes the external wrench at the end-effector.
   void clearExternalWrench() { applyExternalWrench(Vector<6>()); }
+  /// In simulation mode: sets the wrench the environment applies at a point on link `link`, in
+  /// world coordinates (the force acts at `point`; the moment is a pure couple), until changed.
+  /// The simulation adds \f$J_k(p)^T F\f$ to the joint torques, with \f$J_k(p)\f$ the geometric
+  /// Jacobian of the point, so joints beyond link k feel nothing of it directly. One wrench per
+  /// link; it adds to the end-effector's wrench. Callable from any thread; takes effect in the next
+  /// servo cycle (the servo thread never waits for it).
+  /// @param[in] link    link number, 1..n (link k moves with joints 1..k; link n carries the tool)
+  /// @param[in] point   point of application in link k's frame (DH frame k, which moves with the
+  ///                    link; its pose is `linkTransforms[k-1]` of ManipulatorData) [m]
+  /// @param[in] wrench  force [N] then moment [N m] (6 x 1), world coordinates; zero for none
+  /// @throws std::out_of_range if `link` is not in 1..n
+  virtual void applyExternalWrench(int link, const Vector<3>& point, const Vector<6>& wrench) = 0;
+  /// Removes the external wrench on link `link` (1..n).
+  /// @param[in] link  link number
+  /// @throws std::out_of_range if `link` is not in 1..n
+  void clearExternalWrench(int link) { applyExternalWrench(link, Vector<3>(), Vector<6>()); }
   /// @}
 
  protected:

@@ -2,6 +2,8 @@
 /// @file
 /// The dynamic simulation of a manipulator's arm: what a manipulator in simulation mode drives.
 
+#include <array>
+
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
 
@@ -14,7 +16,9 @@ namespace rp {
 /// never reverses the motion, so a joint sticks when the torque is below its Coulomb friction;
 /// torques are saturated at the model's torque limits; joints meet their limits as stiff
 /// spring-damper stops, with sub-steps while a stop is engaged; and brakes hold every joint while
-/// the brakes are on. An external wrench at the end-effector adds \f$J^T F\f$.
+/// the brakes are on. An external wrench at the end-effector adds \f$J^T F\f$; a wrench at a
+/// point on link \f$k\f$ adds \f$J_k(p)^T F\f$, with \f$J_k(p)\f$ the geometric Jacobian of that
+/// point (columns of joints beyond \f$k\f$ zero).
 ///
 /// Deterministic: the same inputs give bit-identical states. Nothing allocates after construction.
 class ManipulatorSimulation {
@@ -49,6 +53,22 @@ class ManipulatorSimulation {
   void setExternalWrench(const Vector<6>& wrench) { wrench_ = wrench; }
   /// The external wrench. Real-time safe: yes.
   const Vector<6>& getExternalWrench() const { return wrench_; }
+  /// Sets the wrench the environment applies at a point on link `link` until changed: force [N]
+  /// then moment [N m], in world coordinates, the force acting at `point`; zero for none. It adds
+  /// \f$J_k(p)^T F\f$ to the joint torques, where \f$J_k(p)\f$ is the geometric Jacobian of the
+  /// point (so joints beyond the link feel nothing of it). One wrench per link.
+  /// @param[in] link    link number, 1..n (link k moves with joints 1..k)
+  /// @param[in] point   point of application in link k's frame (the frame whose pose is
+  ///                    `linkTransforms[k-1]` of ManipulatorData; it moves with the link) [m]
+  /// @param[in] wrench  force [N] and moment [N m] (6 x 1), world coordinates
+  /// @throws std::out_of_range if `link` is not in 1..n
+  /// Real-time safe: yes.
+  void setExternalLinkWrench(int link, const Vector<3>& point, const Vector<6>& wrench);
+  /// Removes the wrenches on all links (not the end-effector's). Real-time safe: yes.
+  void clearExternalLinkWrenches();
+  /// Joint torques [N m] (n x 1) that the external wrenches produced in the last step (taken at
+  /// the positions the step started from). Real-time safe: yes.
+  const JointVector& getExternalTorque() const { return tauExt_; }
 
   /// Stiffness of the joint stops [N m/rad] (default 2e4).
   /// @param[in] stiffness  > 0
@@ -58,11 +78,15 @@ class ManipulatorSimulation {
 
  private:
   void integrate(const JointVector& tau, double h);
+  void externalTorque();
 
   const ManipulatorModel& model_;
   ManipulatorData data_;
   JointVector q_, qd_, qdd_, tauTotal_, tauExt_, coulombPos_, coulombNeg_;
   Vector<6> wrench_;
+  std::array<Vector<3>, kMaxJoints> linkPoint_{};
+  std::array<Vector<6>, kMaxJoints> linkWrench_{};
+  int linkWrenches_ = 0;  // number of links with a non-zero wrench
   bool brakes_ = false;
   double stopStiffness_ = 2e4;
   int lastSubsteps_ = 1;
