@@ -1,13 +1,17 @@
-// Recursive Newton-Euler dynamics for standard-DH serial chains (rp/model/Dynamics.hpp).
+// Recursive Newton-Euler dynamics for serial chains in standard or modified DH, with revolute and
+// prismatic joints (rp/model/Dynamics.hpp).
 //
 // Link quantities live in link coordinates, as in Luh, Walker and Paul's formulation and the
-// Robotics Toolbox's rne_dh: frame i sits at the distal end of link i and joint i turns about
-// z_{i-1}; p*_i = (a_i, d_i sin alpha_i, d_i cos alpha_i) is the origin of frame i seen from frame
-// i-1, in frame i.
+// Robotics Toolbox's rne_dh / rne_mdh: R_i and p_i are the rotation and origin of frame i in frame
+// i-1; s_i is joint i's axis in frame i ((0, sin alpha_i, cos alpha_i) in standard DH, z in
+// modified DH). The linear acceleration of a frame origin is carried outward through a point on
+// the joint axis, which is fixed in both links of a revolute joint: frame i-1's origin in standard
+// DH, frame i's in modified DH. A prismatic joint adds its sliding and Coriolis terms.
 #include "rp/model/Dynamics.hpp"
 
 #include <cmath>
 
+#include "ChainInternal.hpp"
 #include "rp/model/Kinematics.hpp"
 
 namespace rp {
@@ -21,7 +25,7 @@ void rnea(const ManipulatorModel& model, ManipulatorData& data, const JointVecto
           const JointVector& qdd, bool gravity, bool motorInertia, bool friction, const Vector<6>* tipWrench,
           JointVector& tau) {
   const int n = data.n;
-  const V3 z0(0, 0, 1);
+  const bool standard = model.getConvention() == DHConvention::Standard;
   V3 w = V3::Zero(), wd = V3::Zero();
   // Base acceleration -g (in base coordinates) accounts for gravity.
   V3 vd = V3::Zero();
@@ -30,34 +34,39 @@ void rnea(const ManipulatorModel& model, ManipulatorData& data, const JointVecto
   for (int i = 0; i < n; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const LinkParameters& l = model.getLink(i);
-    const double theta = q(i) + l.offset;
-    const double ct = std::cos(theta), st = std::sin(theta);
-    const double ca = model.getCosAlpha()(i), sa = model.getSinAlpha()(i);
+    Eigen::Matrix<double, 3, 4> A;
+    internal::linkMatrix(model, i, q(i), A);
     Matrix<3, 3>& R = data.R[k];
-    R(0, 0) = ct;
-    R(0, 1) = -st * ca;
-    R(0, 2) = st * sa;
-    R(1, 0) = st;
-    R(1, 1) = ct * ca;
-    R(1, 2) = -ct * sa;
-    R(2, 0) = 0;
-    R(2, 1) = sa;
-    R(2, 2) = ca;
-    Vector<3>& ps = data.pstar[k];
-    ps(0) = l.a;
-    ps(1) = l.d * sa;
-    ps(2) = l.d * ca;
-
+    R = A.leftCols<3>();
+    Vector<3>& p = data.pstar[k];  // origin of frame i in frame i-1
+    p = A.col(3);
     const Eigen::Matrix3d Rt = R.transpose();
-    const V3 wPrev = w;
-    w = Rt * (wPrev + z0 * qd(i));
-    wd = Rt * (wd + z0 * qdd(i) + wPrev.cross(z0 * qd(i)));
-    vd = wd.cross(ps) + w.cross(w.cross(ps)) + Rt * vd;
+    const V3 s = standard ? V3(R.row(2).transpose()) : V3::UnitZ();
+    if (l.type == JointType::Prismatic) {
+      vd = Rt * (vd + wd.cross(p) + w.cross(w.cross(p)));
+      w = Rt * w;
+      wd = Rt * wd;
+      vd += 2 * qd(i) * w.cross(s) + qdd(i) * s;
+    } else if (standard) {
+      // Through frame i-1's origin (on the axis): p* = R^T p is fixed in link i.
+      const V3 wi = Rt * w;
+      w = wi + s * qd(i);
+      wd = Rt * wd + s * qdd(i) + wi.cross(s * qd(i));
+      const V3 ps = Rt * p;
+      vd = wd.cross(ps) + w.cross(w.cross(ps)) + Rt * vd;
+    } else {
+      // Through frame i's origin (on the axis), fixed in link i-1.
+      vd = Rt * (vd + wd.cross(p) + w.cross(w.cross(p)));
+      const V3 wi = Rt * w;
+      w = wi + s * qd(i);
+      wd = Rt * wd + s * qdd(i) + wi.cross(s * qd(i));
+    }
     const V3 vc = wd.cross(l.com) + w.cross(w.cross(l.com)) + vd;
     data.F[k] = l.mass * vc;
     data.N[k] = l.inertia * wd + w.cross(l.inertia * w);
   }
 
+  // f, nn: force and moment (about frame i's origin, in frame i) that link i-1 exerts on link i.
   V3 f = V3::Zero(), nn = V3::Zero();
   if (tipWrench != nullptr) {
     f = tipWrench->head<3>();
@@ -66,17 +75,25 @@ void rnea(const ManipulatorModel& model, ManipulatorData& data, const JointVecto
   for (int i = n - 1; i >= 0; --i) {
     const auto k = static_cast<std::size_t>(i);
     const LinkParameters& l = model.getLink(i);
-    const V3& ps = data.pstar[k];
     if (i == n - 1) {
-      nn = nn + ps.cross(f) + (ps + l.com).cross(data.F[k]) + data.N[k];
-      f = f + data.F[k];
+      nn = nn + l.com.cross(data.F[k]) + data.N[k];
     } else {
       const Eigen::Matrix3d& Rn = data.R[k + 1];
-      nn = Rn * (nn + (Rn.transpose() * ps).cross(f)) + (ps + l.com).cross(data.F[k]) + data.N[k];
-      f = Rn * f + data.F[k];
+      f = Rn * f;
+      nn = Rn * nn + V3(data.pstar[k + 1]).cross(f) + l.com.cross(data.F[k]) + data.N[k];
     }
-    // Joint axis z_{i-1} in frame i is the third row of R_i.
-    double t = nn.dot(data.R[k].row(2).transpose());
+    f += data.F[k];
+    const Eigen::Matrix3d& R = data.R[k];
+    const V3 s = standard ? V3(R.row(2).transpose()) : V3::UnitZ();
+    double t;
+    if (l.type == JointType::Prismatic) {
+      t = s.dot(f);
+    } else if (standard) {
+      // Moment about frame i-1's origin, which lies on the axis.
+      t = s.dot(nn + V3(R.transpose() * data.pstar[k]).cross(f));
+    } else {
+      t = nn(2);
+    }
     if (motorInertia) t += model.getArmatureInertia()(i) * qdd(i);
     if (friction) {
       const double g = std::abs(l.gearRatio);
@@ -120,11 +137,11 @@ void coriolisTorque(const ManipulatorModel& model, ManipulatorData& data, const 
 const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                               bool motorInertia) {
   // M = sum over links k of m_k Jv_k^T Jv_k + Jw_k^T I_k Jw_k, with the Jacobians of each link's
-  // centre of mass in the world frame: column j <= k is (z_{j-1} x (c_k - p_{j-1}), z_{j-1}).
+  // centre of mass in the world frame: column j <= k is (z_j x (c_k - p_j), z_j) for a revolute
+  // joint and (z_j, 0) for a prismatic one, z_j and p_j joint j's axis and a point on it.
   forwardKinematics(model, data, q);
   const int n = data.n;
   data.massMatrix.setZero();
-  const Transform& base = model.getBaseTransform();
   for (int k = 0; k < n; ++k) {
     const LinkParameters& l = model.getLink(k);
     const Transform& Tk = data.linkTransforms[static_cast<std::size_t>(k)];
@@ -132,15 +149,21 @@ const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& da
     const V3 c = Rk * Eigen::Vector3d(l.com) + Tk.topRightCorner<3, 1>();
     const Eigen::Matrix3d I = Rk * Eigen::Matrix3d(l.inertia) * Rk.transpose();
     for (int j = 0; j <= k; ++j) {
-      const Transform& before = j == 0 ? base : data.linkTransforms[static_cast<std::size_t>(j - 1)];
-      const V3 z = before.block<3, 1>(0, 2);
-      data.pstar[static_cast<std::size_t>(j)] = z.cross(c - V3(before.topRightCorner<3, 1>()));  // Jv column
-      data.w[static_cast<std::size_t>(j)] = I * z;                                                // I z
+      const auto jj = static_cast<std::size_t>(j);
+      const Transform& axis = internal::axisFrame(model, data, j);
+      const V3 z = axis.block<3, 1>(0, 2);
+      if (model.isPrismatic(j)) {
+        data.pstar[jj] = z;            // Jv column
+        data.wd[jj].setZero();         // Jw column
+      } else {
+        data.pstar[jj] = z.cross(c - V3(axis.topRightCorner<3, 1>()));
+        data.wd[jj] = z;
+      }
+      data.w[jj] = I * data.wd[jj];  // I Jw column
     }
     for (int i = 0; i <= k; ++i) {
-      const Transform& bi = i == 0 ? base : data.linkTransforms[static_cast<std::size_t>(i - 1)];
-      const V3 zi = bi.block<3, 1>(0, 2);
       const V3& vi = data.pstar[static_cast<std::size_t>(i)];
+      const V3& zi = data.wd[static_cast<std::size_t>(i)];
       for (int j = 0; j <= i; ++j) {
         const double m = l.mass * vi.dot(data.pstar[static_cast<std::size_t>(j)]) + zi.dot(data.w[static_cast<std::size_t>(j)]);
         data.massMatrix(i, j) += m;

@@ -1,7 +1,9 @@
-// Forward kinematics and Jacobians for standard-DH serial chains (rp/model/Kinematics.hpp).
+// Forward kinematics and Jacobians for standard- and modified-DH serial chains (rp/model/Kinematics.hpp).
 #include "rp/model/Kinematics.hpp"
 
 #include <cmath>
+
+#include "ChainInternal.hpp"
 
 namespace rp {
 
@@ -10,14 +12,8 @@ const Transform& forwardKinematics(const ManipulatorModel& model, ManipulatorDat
   // T_i = T_{i-1} A_i on the affine part only (the last row of a transform is constant).
   const Transform* previous = &model.getBaseTransform();
   for (int i = 0; i < data.n; ++i) {
-    const LinkParameters& l = model.getLink(i);
-    const double theta = q(i) + l.offset;
-    const double ct = std::cos(theta), st = std::sin(theta);
-    const double ca = model.getCosAlpha()(i), sa = model.getSinAlpha()(i);
     Eigen::Matrix<double, 3, 4> A;
-    A << ct, -st * ca, st * sa, l.a * ct,  //
-        st, ct * ca, -ct * sa, l.a * st,   //
-        0, sa, ca, l.d;
+    internal::linkMatrix(model, i, q(i), A);
     Transform& T = data.linkTransforms[static_cast<std::size_t>(i)];
     T.topRows<3>().noalias() = previous->topLeftCorner<3, 3>() * A;
     T.topRightCorner<3, 1>() += previous->topRightCorner<3, 1>();
@@ -31,18 +27,30 @@ const Transform& forwardKinematics(const ManipulatorModel& model, ManipulatorDat
   return data.endEffector;
 }
 
+namespace internal {
+
+void jacobianFromKinematics(const ManipulatorModel& model, ManipulatorData& data) {
+  const Eigen::Vector3d pe = data.endEffector.topRightCorner<3, 1>();
+  for (int i = 0; i < data.n; ++i) {
+    // Joint i moves about or along the z axis of its axis frame.
+    const Transform& axis = internal::axisFrame(model, data, i);
+    const Eigen::Vector3d z = axis.block<3, 1>(0, 2);
+    if (model.isPrismatic(i)) {
+      data.jacobian.block<3, 1>(0, i) = z;
+      data.jacobian.block<3, 1>(3, i).setZero();
+    } else {
+      data.jacobian.block<3, 1>(0, i) = z.cross(pe - Eigen::Vector3d(axis.topRightCorner<3, 1>()));
+      data.jacobian.block<3, 1>(3, i) = z;
+    }
+  }
+}
+
+}  // namespace internal
+
 const Jacobian& jacobian(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                          ReferenceFrame frame) {
   forwardKinematics(model, data, q);
-  const Eigen::Vector3d pe = data.endEffector.topRightCorner<3, 1>();
-  for (int i = 0; i < data.n; ++i) {
-    // Joint i turns about z of the frame before it (the base for the first joint).
-    const Transform& before = i == 0 ? model.getBaseTransform() : data.linkTransforms[static_cast<std::size_t>(i - 1)];
-    const Eigen::Vector3d z = before.block<3, 1>(0, 2);
-    const Eigen::Vector3d p = before.topRightCorner<3, 1>();
-    data.jacobian.block<3, 1>(0, i) = z.cross(pe - p);
-    data.jacobian.block<3, 1>(3, i) = z;
-  }
+  internal::jacobianFromKinematics(model, data);
   if (frame == ReferenceFrame::EndEffector) {
     const Eigen::Matrix3d Rt = data.endEffector.topLeftCorner<3, 3>().transpose();
     for (int i = 0; i < data.n; ++i) {

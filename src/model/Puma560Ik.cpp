@@ -78,6 +78,21 @@ IkStatus Puma560Model::inverseKinematicsAll(const Transform& pose, std::array<Pu
   return IkStatus::Solved;
 }
 
+Puma560IkSolution Puma560Model::branchOf(const JointVector& q) const {
+  // The inverse of inverseKinematicsAll()'s choices: X = +-sqrt(r2) picks the shoulder,
+  // q3 + phi = +-beta (beta in [0, pi]) the elbow and q5 = -+theta (theta in [0, pi]) the wrist.
+  const double a2 = getLink(1).a, a3 = getLink(2).a, d4 = getLink(3).d;
+  const double c3 = std::cos(q(2)), s3 = std::sin(q(2));
+  const double u = a2 + a3 * c3 - d4 * s3, v = a3 * s3 + d4 * c3;
+  Puma560IkSolution s;
+  s.q = q;
+  s.rightShoulder = u * std::cos(q(1)) - v * std::sin(q(1)) >= 0;
+  s.elbowUp = std::sin(q(2) + std::atan2(d4, a3)) >= 0;
+  s.wristFlipped = wrap(q(4)) > 0;
+  s.withinLimits = isWithinLimits(q);
+  return s;
+}
+
 IkStatus Puma560Model::inverseKinematicsClosest(const Transform& pose, const JointVector& current,
                                                 JointVector& q) const {
   std::array<Puma560IkSolution, 8> all;

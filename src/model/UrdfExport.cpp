@@ -27,22 +27,28 @@ std::string toUrdf(const ManipulatorModel& model) {
   x << "  <link name=\"world\"/>\n  <link name=\"base_link\"/>\n";
   x << "  <joint name=\"base\" type=\"fixed\">\n    <parent link=\"world\"/>\n    <child link=\"base_link\"/>\n    "
     << origin(model.getBaseTransform()) << "\n  </joint>\n";
-  Transform previous = Transform::unit();  // joint k's pose in link k-1
+  // A_k = Pre_k Joint(q_k) Post_k: the URDF link k frame is the joint frame after the motion,
+  // joint k sits at Post_{k-1} Pre_k in link k-1, link k's inertia at Post_k com.
+  Transform previous = Transform::unit();  // Post_{k-1}
+  const bool standard = model.getConvention() == DHConvention::Standard;
   for (int k = 0; k < n; ++k) {
     const LinkParameters& l = model.getLink(k);
-    const Transform M = zRotation(l.offset) * translation(0, 0, l.d) * translation(l.a, 0, 0) * xRotation(l.alpha);
+    const Transform fixed = zRotation(l.offset) * translation(0, 0, l.d);
+    const Transform pre = standard ? fixed : Transform(xRotation(l.alpha) * translation(l.a, 0, 0) * fixed);
+    const Transform post = standard ? Transform(translation(l.a, 0, 0) * xRotation(l.alpha)) : Transform::unit();
     const std::string link = "link" + std::to_string(k + 1);
-    x << "  <link name=\"" << link << "\">\n    <inertial>\n      " << origin(Transform(M * translation(l.com)))
+    x << "  <link name=\"" << link << "\">\n    <inertial>\n      " << origin(Transform(post * translation(l.com)))
       << "\n      <mass value=\"" << l.mass << "\"/>\n      <inertia ixx=\"" << l.inertia(0, 0) << "\" ixy=\""
       << l.inertia(0, 1) << "\" ixz=\"" << l.inertia(0, 2) << "\" iyy=\"" << l.inertia(1, 1) << "\" iyz=\""
       << l.inertia(1, 2) << "\" izz=\"" << l.inertia(2, 2) << "\"/>\n    </inertial>\n  </link>\n";
-    x << "  <joint name=\"joint" << k + 1 << "\" type=\"revolute\">\n    <parent link=\""
-      << (k == 0 ? std::string("base_link") : "link" + std::to_string(k)) << "\"/>\n    <child link=\"" << link
-      << "\"/>\n    " << origin(previous) << "\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" << l.positionMin
-      << "\" upper=\"" << l.positionMax << "\" effort=\"" << l.torqueLimit << "\" velocity=\"" << l.velocityLimit
-      << "\"/>\n    <dynamics damping=\"" << l.viscousFriction * l.gearRatio * l.gearRatio << "\" friction=\""
+    x << "  <joint name=\"joint" << k + 1 << "\" type=\"" << (l.type == JointType::Prismatic ? "prismatic" : "revolute")
+      << "\">\n    <parent link=\"" << (k == 0 ? std::string("base_link") : "link" + std::to_string(k))
+      << "\"/>\n    <child link=\"" << link << "\"/>\n    " << origin(Transform(previous * pre))
+      << "\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" << l.positionMin << "\" upper=\"" << l.positionMax
+      << "\" effort=\"" << l.torqueLimit << "\" velocity=\"" << l.velocityLimit << "\"/>\n    <dynamics damping=\""
+      << l.viscousFriction * l.gearRatio * l.gearRatio << "\" friction=\""
       << std::abs(l.gearRatio) * 0.5 * (l.coulombFrictionPositive - l.coulombFrictionNegative) << "\"/>\n  </joint>\n";
-    previous = M;
+    previous = post;
   }
   x << "  <link name=\"tool\"/>\n  <joint name=\"tool\" type=\"fixed\">\n    <parent link=\"link" << n
     << "\"/>\n    <child link=\"tool\"/>\n    " << origin(Transform(previous * model.getToolTransform()))

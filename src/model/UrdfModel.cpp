@@ -90,7 +90,9 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
       }
       const urdf::JointConstSharedPtr j = link->child_joints.front();
       link = robot->getLink(j->child_link_name);
-      if (j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS) lastMovable = link;
+      if (j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS || j->type == urdf::Joint::PRISMATIC) {
+        lastMovable = link;
+      }
     }
     tip = lastMovable ? lastMovable : link;
   }
@@ -129,7 +131,8 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     const Transform jointFrame = Transform(linkPose * toTransform(j->parent_to_joint_origin_transform));
     switch (j->type) {
       case urdf::Joint::REVOLUTE:
-      case urdf::Joint::CONTINUOUS: {
+      case urdf::Joint::CONTINUOUS:
+      case urdf::Joint::PRISMATIC: {
         V3 axis(j->axis.x, j->axis.y, j->axis.z);
         if (axis.norm() < 1e-12) throw UrdfError(fileName + ": joint '" + j->name + "' has a zero axis");
         axis = jointFrame.topLeftCorner<3, 3>() * axis.normalized();
@@ -140,19 +143,19 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
       }
       case urdf::Joint::FIXED:
         break;
-      case urdf::Joint::PRISMATIC:
-        throw UrdfError(fileName + ": joint '" + j->name + "' is prismatic; only revolute, continuous and fixed joints are supported");
       default:
-        throw UrdfError(fileName + ": joint '" + j->name + "' is floating or planar; a manipulator is a chain of revolute, continuous and fixed joints");
+        throw UrdfError(fileName + ": joint '" + j->name +
+                        "' is floating or planar; a manipulator is a chain of revolute, continuous, prismatic and fixed joints");
     }
     linkPose = jointFrame;
     addInertial(robot->getLink(j->child_link_name), linkPose);
   }
   const int n = static_cast<int>(axes.size());
-  if (n == 0) throw UrdfError(fileName + ": no revolute or continuous joint between the root and '" + tip->name + "'");
+  if (n == 0) throw UrdfError(fileName + ": no revolute, continuous or prismatic joint between the root and '" + tip->name + "'");
   if (n > kMaxJoints) throw UrdfError(fileName + ": " + std::to_string(n) + " joints; at most " + std::to_string(kMaxJoints));
 
-  // Standard DH frames F_0..F_n in root coordinates: z_{i-1} along joint i's axis, x_i along the
+  // Standard DH frames F_0..F_n in root coordinates (a prismatic joint's line is taken through its
+  // joint origin: only its direction matters): z_{i-1} along joint i's axis, x_i along the
   // common normal from axis i to axis i+1, origin of F_i on axis i+1; F_n = F_{n-1}.
   std::vector<Transform> F(static_cast<std::size_t>(n + 1));
   std::vector<V3> origin(static_cast<std::size_t>(n + 1)), xs(static_cast<std::size_t>(n + 1));
@@ -208,6 +211,9 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     l.alpha = std::atan2(zp.cross(zq).dot(xq), zp.dot(zq));
     l.offset = std::atan2(xp.cross(xq).dot(zp), xp.dot(xq));
     const urdf::JointConstSharedPtr& j = movable[static_cast<std::size_t>(i - 1)];
+    // A prismatic joint slides along z_{i-1}, which moves the rest of the chain without changing
+    // the common normals: d_i = q_i + d (at q = 0 as measured) and theta_i = offset constant.
+    if (j->type == urdf::Joint::PRISMATIC) l.type = JointType::Prismatic;
     if (j->type == urdf::Joint::CONTINUOUS || !j->limits) {
       l.positionMin = -2 * std::numbers::pi;
       l.positionMax = 2 * std::numbers::pi;

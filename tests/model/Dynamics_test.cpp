@@ -1,4 +1,5 @@
-// Internal consistency of the dynamics on seeded random states of every built-in robot:
+// Internal consistency of the dynamics on seeded random states of every built-in robot, of the
+// modified-DH Puma 560 and of a URDF arm with prismatic joints (standard and modified DH):
 // RNEA = M qdd + C + g, forward dynamics inverts inverse dynamics, the Jacobian matches finite
 // differences of forward kinematics, and J^T F matches the Newton-Euler tip wrench.
 #include <Eigen/Eigenvalues>
@@ -9,7 +10,9 @@
 
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
+#include "ModifiedDh.hpp"
 #include "rp/model/Puma560Model.hpp"
+#include "rp/model/UrdfModel.hpp"
 #include "rp/model/WAMModel.hpp"
 
 namespace rp {
@@ -20,6 +23,12 @@ std::vector<std::unique_ptr<ManipulatorModel>> robots() {
   r.push_back(std::make_unique<Puma560Model>());
   r.push_back(std::make_unique<WAM7Model>());
   r.push_back(std::make_unique<WAM4Model>());
+  r.push_back(test::toModifiedDh(Puma560Model()));
+  UrdfOptions o;
+  o.tip = "tool";
+  o.requireDynamics = true;
+  r.push_back(loadUrdf(std::string(RP_TEST_DATA_DIR) + "/prismatic_arm.urdf", o));
+  r.push_back(test::toModifiedDh(*r.back()));
   return r;
 }
 

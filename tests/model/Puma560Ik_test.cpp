@@ -7,6 +7,8 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <set>
+#include <string>
 
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/Puma560Model.hpp"
@@ -85,16 +87,22 @@ TEST(Puma560Ik, EightBranchesMatchTheToolbox) {
   }
 }
 
+// Random joint angles with |q5| in [0.05, pi - 0.05] (off the wrist singularity), its sign alternating.
+JointVector randomOffWristSingularity(std::mt19937_64& rng, int trial) {
+  std::uniform_real_distribution<double> u(-kPi, kPi);
+  JointVector q(6);
+  for (int i = 0; i < 6; ++i) q(i) = u(rng);
+  q(4) = std::uniform_real_distribution<double>(0.05, kPi - 0.05)(rng) * (trial % 2 ? 1 : -1);
+  return q;
+}
+
 TEST(Puma560Ik, EveryBranchReproducesRandomPosesAndTheClosestIsChosen) {
   Puma560Model model;
   ManipulatorData data(model);
   std::mt19937_64 rng(99);
-  std::uniform_real_distribution<double> u(-kPi, kPi);
   int withinLimits = 0;
   for (int trial = 0; trial < 1000; ++trial) {
-    JointVector q(6);
-    for (int i = 0; i < 6; ++i) q(i) = u(rng);
-    q(4) = std::uniform_real_distribution<double>(0.05, kPi - 0.05)(rng) * (trial % 2 ? 1 : -1);  // off the wrist singularity
+    const JointVector q = randomOffWristSingularity(rng, trial);
     const Transform T = forwardKinematics(model, data, q);
     std::array<Puma560IkSolution, 8> all;
     ASSERT_EQ(model.inverseKinematicsAll(T, all), IkStatus::Solved);
@@ -109,6 +117,37 @@ TEST(Puma560Ik, EveryBranchReproducesRandomPosesAndTheClosestIsChosen) {
     }
   }
   EXPECT_GT(withinLimits, 0);
+}
+
+TEST(Puma560Ik, BranchOfEachSolutionIsItsLabel) {
+  // For each of the eight solutions of 2,000 random poses, branchOf() names the branch that
+  // inverseKinematicsAll() labelled it with; the eight labels of a pose are all different.
+  Puma560Model model;
+  ManipulatorData data(model);
+  std::mt19937_64 rng(123);
+  int checked = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const JointVector q = randomOffWristSingularity(rng, trial);
+    const Transform T = forwardKinematics(model, data, q);
+    std::array<Puma560IkSolution, 8> all;
+    ASSERT_EQ(model.inverseKinematicsAll(T, all), IkStatus::Solved);
+    std::set<std::string> names;
+    for (const Puma560IkSolution& s : all) {
+      const Puma560IkSolution b = model.branchOf(s.q);
+      EXPECT_STREQ(b.branchName(), s.branchName()) << "trial " << trial;
+      EXPECT_EQ(b.withinLimits, s.withinLimits);
+      names.insert(s.branchName());
+      ++checked;
+    }
+    EXPECT_EQ(names.size(), 8u);
+    // The configuration the pose came from is the solution labelled with its branch.
+    const std::string original = model.branchOf(q).branchName();
+    for (const Puma560IkSolution& s : all) {
+      if (original != s.branchName()) continue;
+      for (int i = 0; i < 6; ++i) EXPECT_LT(angleDistance(s.q(i), q(i)), 1e-8) << original << " joint " << i + 1;
+    }
+  }
+  EXPECT_EQ(checked, 16000);
 }
 
 TEST(Puma560Ik, UnreachablePosesSaySoWithoutNaNs) {

@@ -7,6 +7,7 @@
 
 #include <kdl/chain.hpp>
 #include <kdl/chaindynparam.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
@@ -16,6 +17,7 @@
 #include <sstream>
 
 #include "KdlChain.hpp"
+#include "ModifiedDh.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/Puma560Model.hpp"
@@ -51,14 +53,7 @@ std::vector<urdf::JointConstSharedPtr> chainTo(const urdf::ModelInterfaceSharedP
   return chain;
 }
 
-KDL::Frame kdlFrame(const Transform& t) {
-  KDL::Frame f;
-  for (int r = 0; r < 3; ++r) {
-    f.p(r) = t(r, 3);
-    for (int c = 0; c < 3; ++c) f.M(r, c) = t(r, c);
-  }
-  return f;
-}
+using test::kdlFrame;
 
 KDL::RigidBodyInertia kdlInertia(const urdf::Inertial& i) {
   const Transform T = pose(i.origin);
@@ -70,7 +65,8 @@ KDL::RigidBodyInertia kdlInertia(const urdf::Inertial& i) {
                                KDL::RotationalInertia(Il(0, 0), Il(1, 1), Il(2, 2), Il(0, 1), Il(0, 2), Il(1, 2)));
 }
 
-// The KDL chain of the URDF, the way kdl_parser builds it; the camera (fixed to l3, off the chain)
+// The KDL chain of the URDF, the way kdl_parser builds it (revolute joints about, prismatic joints
+// along their axis); the camera (fixed to l3, off the chain)
 // is added to l3's inertia.
 KDL::Chain kdlFromUrdf(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip) {
   KDL::Chain chain;
@@ -87,8 +83,8 @@ KDL::Chain kdlFromUrdf(const urdf::ModelInterfaceSharedPtr& robot, const std::st
       chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, KDL::Joint::Fixed), origin, inertia));
     } else {
       const KDL::Vector axis = origin.M * KDL::Vector(j->axis.x, j->axis.y, j->axis.z);
-      chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, origin.p, axis, KDL::Joint::RotAxis),
-                                    origin, inertia));
+      const KDL::Joint::JointType type = j->type == urdf::Joint::PRISMATIC ? KDL::Joint::TransAxis : KDL::Joint::RotAxis;
+      chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, origin.p, axis, type), origin, inertia));
     }
   }
   return chain;
@@ -143,6 +139,113 @@ TEST(UrdfModel, ForwardKinematicsAndDynamicsMatchUrdfdomAndKdl) {
     const JointMatrix& M = massMatrix(*model, data, q);
     for (int r = 0; r < 6; ++r)
       for (int c = 0; c < 6; ++c) ASSERT_NEAR(M(r, c), km(static_cast<unsigned>(r), static_cast<unsigned>(c)), 1e-9);
+  }
+}
+
+// The URDF walk: T = prod origin_j * Rot(axis_j, q_j) or Trans(axis_j, q_j).
+Transform walk(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip, const JointVector& q) {
+  Transform T = Transform::unit();
+  int k = 0;
+  for (const urdf::JointConstSharedPtr& j : chainTo(robot, tip)) {
+    T = Transform(T * pose(j->parent_to_joint_origin_transform));
+    const Vector<3> axis{{j->axis.x}, {j->axis.y}, {j->axis.z}};
+    if (j->type == urdf::Joint::PRISMATIC) T = Transform(T * translation(Vector<3>(q(k++) * axis.normalized())));
+    else if (j->type != urdf::Joint::FIXED) T = Transform(T * rotation(axis, q(k++)));
+  }
+  return T;
+}
+
+TEST(UrdfModel, PrismaticJointsMatchUrdfWalkAndKdl) {
+  UrdfOptions options;
+  options.tip = "tool";
+  options.requireDynamics = true;
+  const std::unique_ptr<ManipulatorModel> model = loadUrdf(kData + "/prismatic_arm.urdf", options);
+  ASSERT_EQ(model->getNumberOfJoints(), 6);
+  EXPECT_TRUE(model->isPrismatic(1));
+  EXPECT_TRUE(model->isPrismatic(3));
+  EXPECT_FALSE(model->isPrismatic(0));
+  EXPECT_DOUBLE_EQ(model->getPositionMin()(1), -0.2);
+  EXPECT_DOUBLE_EQ(model->getPositionMax()(3), 0.35);
+  EXPECT_DOUBLE_EQ(model->getTorqueLimit()(1), 300);
+  const urdf::ModelInterfaceSharedPtr robot = parse(kData + "/prismatic_arm.urdf");
+  const KDL::Chain chain = kdlFromUrdf(robot, "tool");
+  KDL::ChainFkSolverPos_recursive fk(chain);
+  KDL::ChainIdSolver_RNE id(chain, KDL::Vector(0, 0, -9.81));
+  KDL::ChainJntToJacSolver jac(chain);
+  KDL::ChainDynParam dyn(chain, KDL::Vector(0, 0, -9.81));
+  ManipulatorData data(*model);
+  std::mt19937_64 rng(78);
+  std::uniform_real_distribution<double> u(0, 1);
+  double worstFk = 0, worstJ = 0, worstTau = 0, worstM = 0;
+  for (int trial = 0; trial < 1000; ++trial) {
+    JointVector q(6), qd(6), qdd(6);
+    for (int i = 0; i < 6; ++i) {
+      q(i) = model->getPositionMin()(i) + u(rng) * (model->getPositionMax()(i) - model->getPositionMin()(i));
+      qd(i) = 2 * u(rng) - 1;
+      qdd(i) = 6 * u(rng) - 3;
+    }
+    const Transform& T = forwardKinematics(*model, data, q);
+    worstFk = std::max(worstFk, (T - walk(robot, "tool", q)).cwiseAbs().maxCoeff());
+    const KDL::JntArray kq = test::kdlJoints(q), kqd = test::kdlJoints(qd), kqdd = test::kdlJoints(qdd);
+    KDL::Frame f;
+    ASSERT_GE(fk.JntToCart(kq, f), 0);
+    for (int r = 0; r < 3; ++r) {
+      worstFk = std::max(worstFk, std::abs(T(r, 3) - f.p(r)));
+      for (int c = 0; c < 3; ++c) worstFk = std::max(worstFk, std::abs(T(r, c) - f.M(r, c)));
+    }
+    KDL::Jacobian kj(6);
+    ASSERT_GE(jac.JntToJac(kq, kj), 0);
+    const Jacobian& J = jacobian(*model, data, q);
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) worstJ = std::max(worstJ, std::abs(J(r, c) - kj(static_cast<unsigned>(r), static_cast<unsigned>(c))));
+    kj.changeBase(f.M.Inverse());
+    const Jacobian& Je = jacobian(*model, data, q, ReferenceFrame::EndEffector);
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) worstJ = std::max(worstJ, std::abs(Je(r, c) - kj(static_cast<unsigned>(r), static_cast<unsigned>(c))));
+    KDL::JntArray ktau(6);
+    KDL::Wrenches w(chain.getNrOfSegments(), KDL::Wrench::Zero());
+    ASSERT_GE(id.CartToJnt(kq, kqd, kqdd, w, ktau), 0);
+    const JointVector& tau = inverseDynamics(*model, data, q, qd, qdd);
+    for (int i = 0; i < 6; ++i) worstTau = std::max(worstTau, std::abs(tau(i) - ktau(static_cast<unsigned>(i))));
+    KDL::JntSpaceInertiaMatrix km(6);
+    ASSERT_GE(dyn.JntToMass(kq, km), 0);
+    const JointMatrix& M = massMatrix(*model, data, q);
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) worstM = std::max(worstM, std::abs(M(r, c) - km(static_cast<unsigned>(r), static_cast<unsigned>(c))));
+  }
+  EXPECT_LT(worstFk, 1e-9);
+  EXPECT_LT(worstJ, 1e-9);
+  EXPECT_LT(worstTau, 1e-9);
+  EXPECT_LT(worstM, 1e-9);
+}
+
+TEST(UrdfModel, ExportedPrismaticAndModifiedDhArmsLoadBack) {
+  UrdfOptions options;
+  options.tip = "tool";
+  const std::unique_ptr<ManipulatorModel> arm = loadUrdf(kData + "/prismatic_arm.urdf", options);
+  const std::unique_ptr<ManipulatorModel> mdh = test::toModifiedDh(Puma560Model());
+  for (const ManipulatorModel* model : {arm.get(), mdh.get()}) {
+    const std::string text = toUrdf(*model);
+    const std::string file = testing::TempDir() + "/" + model->getName() + "_roundtrip.urdf";
+    std::ofstream(file) << text;
+    const std::unique_ptr<ManipulatorModel> back = loadUrdf(file, options);
+    ASSERT_EQ(back->getNumberOfJoints(), model->getNumberOfJoints());
+    const int n = model->getNumberOfJoints();
+    for (int i = 0; i < n; ++i) EXPECT_EQ(back->isPrismatic(i), model->isPrismatic(i)) << model->getName();
+    ManipulatorData a(*model), b(*back);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int trial = 0; trial < 200; ++trial) {
+      JointVector q(n), qd(n), qdd(n);
+      for (int i = 0; i < n; ++i) {
+        q(i) = model->getPositionMin()(i) + u(rng) * (model->getPositionMax()(i) - model->getPositionMin()(i));
+        qd(i) = 2 * u(rng) - 1;
+        qdd(i) = 2 * u(rng) - 1;
+      }
+      ASSERT_LT((forwardKinematics(*model, a, q) - forwardKinematics(*back, b, q)).cwiseAbs().maxCoeff(), 1e-12);
+      const JointVector t1 = inverseDynamics(*model, a, q, qd, qdd), t2 = inverseDynamics(*back, b, q, qd, qdd);
+      for (int i = 0; i < n; ++i) ASSERT_NEAR(t1(i), t2(i), 1e-9) << model->getName();
+    }
   }
 }
 

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <vector>
 
 #include "AllocationCounter.hpp"
 #include "rp/model/Model.hpp"
@@ -41,6 +42,66 @@ TEST(ModelRealtime, AlgorithmsDoNotAllocate) {
     sink += puma.inverseKinematicsAll(target, branches) == IkStatus::Solved;
     sink += puma.inverseKinematicsClosest(target, q, out) == IkStatus::Solved;
     sink += inverseKinematics(wam, wd, wamTarget, wq, wout) == IkStatus::Solved;
+    sink += puma.branchOf(q).rightShoulder;
+  }
+  EXPECT_EQ(guard.count(), 0u);
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+TEST(ModelRealtime, PrismaticAndModifiedDhAlgorithmsDoNotAllocate) {
+  // A five-joint arm in modified DH with two prismatic joints (a lift and a telescope).
+  std::vector<LinkParameters> links(5);
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    LinkParameters& l = links[i];
+    l.mass = 2.0 - 0.3 * static_cast<double>(i);
+    l.com(0) = 0.05;
+    l.com(2) = 0.02;
+    l.inertia = Matrix<3, 3>::Identity() * 0.01;
+    l.motorInertia = 1e-4;
+    l.gearRatio = 50;
+    l.viscousFriction = 1e-3;
+  }
+  links[1].type = JointType::Prismatic;
+  links[1].positionMin = -0.2;
+  links[1].positionMax = 0.3;
+  links[2].alpha = 1.5707963267948966;
+  links[2].a = 0.1;
+  links[3].type = JointType::Prismatic;
+  links[3].alpha = -1.5707963267948966;
+  links[3].positionMin = 0;
+  links[3].positionMax = 0.4;
+  links[4].d = 0.1;
+  const ManipulatorModel arm("lift_arm", links, Transform::unit(), Transform::unit(), ManipulatorModel::standardGravity(),
+                             DHConvention::Modified);
+  ManipulatorData d(arm);
+  JointVector q(5), qd(5), qdd(5), out(5);
+  q << 0.3, 0.1, -0.4, 0.2, 0.7;
+  qd.setConstant(0.2);
+  qdd.setConstant(-0.1);
+  Vector<6> wrench;
+  wrench(0) = 2;
+  DynamicsOptions all;
+  all.motorInertia = true;
+  all.friction = true;
+  JointVector q2 = q;
+  q2(1) = 0.15;
+  q2(3) = 0.25;
+  const Transform target = forwardKinematics(arm, d, q2);
+  IkOptions position;
+  position.positionOnly = true;
+  position.timeBudget = 1e-3;
+  double sink = 0;
+  test::AllocationGuard guard;
+  for (int i = 0; i < 100; ++i) {
+    sink += forwardKinematics(arm, d, q)(0, 3);
+    sink += jacobian(arm, d, q, ReferenceFrame::EndEffector)(0, 1);
+    endEffectorForceToJointTorque(arm, d, q, wrench, out);
+    sink += inverseDynamics(arm, d, q, qd, qdd, all)(1);
+    gravityTorque(arm, d, q, out);
+    coriolisTorque(arm, d, q, qd, out);
+    sink += massMatrix(arm, d, q, true)(1, 1);
+    sink += forwardDynamics(arm, d, q, qd, out, all)(3);
+    sink += inverseKinematics(arm, d, target, q, out, position) == IkStatus::Solved;
   }
   EXPECT_EQ(guard.count(), 0u);
   EXPECT_TRUE(std::isfinite(sink));

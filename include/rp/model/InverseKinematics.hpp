@@ -21,13 +21,26 @@ struct IkOptions {
   double orientationTolerance = 1e-6;  ///< largest orientation error accepted [rad]
   bool positionOnly = false;           ///< ignore the orientation
   int maxIterations = 200;             ///< iterations per attempt
-  int maxAttempts = 20;                ///< the seed first, then random restarts within the limits
+  int maxAttempts = 100;               ///< the seed first, then random restarts within the limits
   std::uint64_t randomSeed = 1;        ///< seed of the restarts (deterministic)
+  /// Time budget [s]: when > 0, random restarts within the joint limits continue until a solution
+  /// is found or this much (steady-clock) time is spent, and `maxAttempts` is ignored; 0: no time
+  /// limit, `maxAttempts` attempts.
+  double timeBudget = 0;
+  /// An attempt that has not reduced its error by half within this many iterations is abandoned
+  /// for a restart (stagnation, typically against a joint limit); 0: never.
+  int stallIterations = 12;
 };
 
 /// Solves \f$FK(q) = T\f$ by damped least squares (Levenberg-Marquardt) on the geometric
 /// Jacobian, keeping every joint inside its limits, starting from `seed` and then from random
-/// configurations within the limits.
+/// configurations within the limits (until `maxAttempts` or the `timeBudget` is spent).
+///
+/// Each iteration takes the step \f$\Delta q = J^T (J J^T + \lambda I)^{-1} e\f$ (a 6 x 6, or
+/// 3 x 3 position-only, fixed-size solve) on the pose error \f$e\f$ (position, rotation vector,
+/// world frame), clamps to the limits and keeps it only if it lowers the error; the damping
+/// \f$\lambda = \mu (\tfrac12 |e|^2 + 10^{-9})\f$ follows the error (Sugihara 2011) with \f$\mu\f$
+/// lowered after a success and raised after a failure. Stagnating attempts restart early.
 /// @param[in]  model    the manipulator
 /// @param[out] data     scratch
 /// @param[in]  target   the end-effector pose wanted, in the world [m]
@@ -35,7 +48,9 @@ struct IkOptions {
 /// @param[out] q        the solution (n x 1) [rad] (the best attempt if not solved)
 /// @param[in]  options  tolerances and budget
 /// @return Solved or NotConverged
-/// Real-time safe: yes (no allocation), but its run time depends on the pose.
+/// @throws std::invalid_argument if `seed` does not have one value per joint
+/// Real-time safe: yes (no allocation), but its run time depends on the pose (bound it with
+/// `timeBudget`).
 IkStatus inverseKinematics(const ManipulatorModel& model, ManipulatorData& data, const Transform& target,
                            const JointVector& seed, JointVector& q, const IkOptions& options = IkOptions());
 

@@ -25,9 +25,25 @@ enum class DHConvention {
   /// Standard (distal) DH: \f$A_i = R_z(\theta_i) T_z(d_i) T_x(a_i) R_x(\alpha_i)\f$; link frame
   /// \f$i\f$ sits at the distal end of link \f$i\f$ and joint \f$i\f$ turns about \f$z_{i-1}\f$.
   Standard,
+  /// Modified (proximal, Craig 1989) DH: \f$A_i = R_x(\alpha_{i-1}) T_x(a_{i-1}) R_z(\theta_i) T_z(d_i)\f$;
+  /// link frame \f$i\f$ sits at the proximal end of link \f$i\f$, on joint \f$i\f$'s axis, and joint
+  /// \f$i\f$ moves about or along \f$z_i\f$. LinkParameters `a` and `alpha` of link \f$i\f$ hold
+  /// \f$a_{i-1}\f$ and \f$\alpha_{i-1}\f$ (the Robotics Toolbox's `RevoluteMDH` convention).
+  Modified,
+};
+
+/// The kind of a joint.
+enum class JointType {
+  Revolute,   ///< turns about its z axis: \f$\theta_i = q_i + \mathrm{offset}_i\f$, joint value in [rad]
+  Prismatic,  ///< slides along its z axis: \f$d_i = q_i + d_i^0\f$, joint value in [m]
 };
 
 /// Constant parameters of one link and its joint (all SI units, radians).
+///
+/// The joint variable enters the DH parameters as \f$\theta_i = \mathrm{offset} + q_i\f$ for a
+/// revolute joint and \f$d_i = d + q_i\f$ for a prismatic one (whose \f$\theta_i\f$ is then the
+/// constant `offset`). For a prismatic joint, position limits are in [m], speeds in [m/s],
+/// torques are forces [N] and inertias masses [kg].
 ///
 /// Friction and motor inertia follow the Robotics Toolbox's convention: they are given on the
 /// motor side and reflected to the joint through the gear ratio \f$G\f$: armature inertia
@@ -35,8 +51,8 @@ enum class DHConvention {
 struct LinkParameters {
   double a = 0;       ///< DH link length [m]
   double alpha = 0;   ///< DH link twist [rad]
-  double d = 0;       ///< DH link offset [m]
-  double offset = 0;  ///< joint angle offset: \f$\theta_i = q_i + \mathrm{offset}\f$ [rad]
+  double d = 0;       ///< DH link offset [m]; for a prismatic joint the offset of \f$d_i = q_i + d\f$
+  double offset = 0;  ///< joint angle offset: \f$\theta_i = q_i + \mathrm{offset}\f$ (prismatic: \f$\theta_i\f$) [rad]
 
   double mass = 0;                          ///< link mass [kg]
   Vector<3> com;                            ///< centre of mass in link frame \f$i\f$ [m]
@@ -53,9 +69,11 @@ struct LinkParameters {
   double accelerationLimit = 10.0;          ///< largest joint acceleration for trajectories [rad/s^2]
   double jerkLimit = 100.0;                 ///< largest joint jerk for trajectories [rad/s^3]
   double torqueLimit = 100.0;               ///< largest joint torque [N m]
+  JointType type = JointType::Revolute;     ///< revolute or prismatic joint
 };
 
-/// The constant model of a serial manipulator with revolute joints: Denavit-Hartenberg
+/// The constant model of a serial manipulator with revolute and prismatic joints: Denavit-Hartenberg
+/// (standard or modified)
 /// kinematics, rigid-body dynamics, motor inertia, friction and limits, a base transform (the
 /// robot's pose in the world) and a tool transform (end-effector relative to the last link frame).
 ///
@@ -95,6 +113,8 @@ class ManipulatorModel {
   const LinkParameters& getLink(int i) const { return links_[static_cast<std::size_t>(i)]; }
   /// DH convention. Real-time safe: yes.
   DHConvention getConvention() const { return convention_; }
+  /// Whether joint `i` (from 0) is prismatic. Real-time safe: yes.
+  bool isPrismatic(int i) const { return getLink(i).type == JointType::Prismatic; }
   /// Pose of the base in the world [m]. Real-time safe: yes.
   const Transform& getBaseTransform() const { return base_; }
   /// Pose of the end-effector in the last link frame [m]. Real-time safe: yes.

@@ -60,6 +60,19 @@ class Puma560Model : public ManipulatorModel {
   /// @return Solved, Unreachable, or NotConverged when no branch is within the limits
   /// Real-time safe: yes.
   IkStatus inverseKinematicsClosest(const Transform& pose, const JointVector& current, JointVector& q) const;
+
+  /// The branch a configuration lies on, labelled as inverseKinematicsAll() labels its solutions:
+  /// for every solution `s` of a pose, `branchOf(s.q)` has the same `rightShoulder`, `elbowUp`
+  /// and `wristFlipped` (and so the same branchName()). Shoulder right: the wrist centre's
+  /// coordinate along the arm plane's x axis, \f$X = u\cos q_2 - v\sin q_2\f$ with
+  /// \f$u = a_2 + a_3\cos q_3 - d_4\sin q_3\f$, \f$v = a_3\sin q_3 + d_4\cos q_3\f$, is >= 0; elbow up:
+  /// \f$\sin(q_3 + \mathrm{atan2}(d_4, a_3)) \ge 0\f$; wrist flipped: \f$q_5\f$ (wrapped to
+  /// \f$(-\pi, \pi]\f$) > 0. On a boundary (X = 0, the elbow stretched, q5 = 0 or pi) both labels
+  /// describe the configuration and the one given is the first of the two.
+  /// @param[in] q  joint angles (6 x 1) [rad]
+  /// @return `q`, its labels, and whether it is within the joint limits
+  /// Real-time safe: yes.
+  Puma560IkSolution branchOf(const JointVector& q) const;
 };
 
 }  // namespace rp

@@ -9,13 +9,16 @@
 
 namespace rp {
 
-/// The URDF text of `model`: links `base_link`, `link1`..`linkN` and `tool`, revolute joints
-/// `joint1`..`jointN` with the model's limits (effort = torque limit, velocity limit), inertias
+/// The URDF text of `model`: links `base_link`, `link1`..`linkN` and `tool`, revolute or
+/// prismatic joints `joint1`..`jointN` with the model's limits (effort = torque limit, velocity limit), inertias
 /// at each link's centre of mass, and fixed joints for the base and tool transforms.
 ///
-/// Frames: URDF link k is the DH frame k-1 turned by joint k about its z axis; joint k+1 sits at
-/// \f$T_z(d_k) T_x(a_k) R_x(\alpha_k)\f$ in it, so forward kinematics of the URDF equals the
-/// model's for every joint vector (tested with urdfdom).
+/// Frames: with each link transform split as \f$A_k = P_k\,J(q_k)\,Q_k\f$ (standard DH:
+/// \f$P_k = R_z(\mathrm{offset}_k) T_z(d_k)\f$, \f$Q_k = T_x(a_k) R_x(\alpha_k)\f$; modified DH:
+/// \f$P_k = R_x(\alpha_k) T_x(a_k) R_z(\mathrm{offset}_k) T_z(d_k)\f$, \f$Q_k = 1\f$), URDF link k is
+/// the frame after joint k's motion \f$J\f$ (about or along z) and joint k sits at
+/// \f$Q_{k-1} P_k\f$ in link k-1, so forward kinematics of the URDF equals the model's for every
+/// joint vector (tested with urdfdom).
 /// @param[in] model  the manipulator
 /// @return the URDF document
 /// Real-time safe: no.

@@ -26,19 +26,20 @@ struct UrdfOptions {
 
 /// Loads the serial chain from the URDF root link to a tip link as a ManipulatorModel.
 ///
-/// Revolute and continuous joints become the model's joints, fixed joints are merged into the
-/// links around them (their inertias combined about the common centre of mass), and the chain is
-/// re-expressed in standard Denavit-Hartenberg frames (always possible for revolute joints): the
+/// Revolute, continuous and prismatic joints become the model's joints, fixed joints are merged
+/// into the links around them (their inertias combined about the common centre of mass), and the
+/// chain is re-expressed in standard Denavit-Hartenberg frames (always possible): the
 /// base transform places DH frame 0 in the URDF root frame and the tool transform places the tip
 /// link in the last DH frame, so forward kinematics equals the URDF's for every joint vector and
-/// joint angles keep the URDF's zero and sign. Limits come from `<limit>` (continuous joints get
+/// joint values keep the URDF's zero and sign (a prismatic joint's value in metres along its
+/// axis). Limits come from `<limit>` (continuous joints get
 /// +-2 pi; a missing effort or velocity the ManipulatorModel defaults); `<dynamics damping
 /// friction>` become viscous and Coulomb friction.
 /// @param[in] fileName  path of the URDF file
 /// @param[in] options   tip link and whether dynamics are required
 /// @return the model, named after the robot
 /// @throws UrdfError naming the file for: a missing or unreadable file, malformed XML or URDF, a
-///         floating, planar or prismatic joint in the chain, an unknown tip, a branching robot
+///         floating or planar joint in the chain, an unknown tip, a branching robot
 ///         without a tip, no movable joint, and (with requireDynamics) a moving link without
 ///         inertial data
 /// Real-time safe: no.

@@ -1,0 +1,41 @@
+#pragma once
+// Link transforms and joint axes shared by the kinematics, dynamics and IK algorithms, for both
+// DH conventions and both joint types (private to src/model).
+#include <cmath>
+
+#include "rp/model/ManipulatorData.hpp"
+
+namespace rp::internal {
+
+// The affine part (3 x 4) of A_i, the pose of link frame i in frame i-1, for joint value qi.
+inline void linkMatrix(const ManipulatorModel& model, int i, double qi, Eigen::Matrix<double, 3, 4>& A) {
+  const LinkParameters& l = model.getLink(i);
+  const bool prismatic = l.type == JointType::Prismatic;
+  const double theta = prismatic ? l.offset : qi + l.offset;
+  const double d = prismatic ? l.d + qi : l.d;
+  const double ct = std::cos(theta), st = std::sin(theta);
+  const double ca = model.getCosAlpha()(i), sa = model.getSinAlpha()(i);
+  if (model.getConvention() == DHConvention::Standard) {
+    // Rz(theta) Tz(d) Tx(a) Rx(alpha)
+    A << ct, -st * ca, st * sa, l.a * ct,  //
+        st, ct * ca, -ct * sa, l.a * st,   //
+        0, sa, ca, d;
+  } else {
+    // Rx(alpha) Tx(a) Rz(theta) Tz(d)
+    A << ct, -st, 0, l.a,              //
+        ca * st, ca * ct, -sa, -sa * d,  //
+        sa * st, sa * ct, ca, ca * d;
+  }
+}
+
+// The world frame whose z axis is joint j's axis and whose origin lies on that axis, from the last
+// forward kinematics: frame j-1 (the base for j = 0) in standard DH, frame j in modified DH.
+inline const Transform& axisFrame(const ManipulatorModel& model, const ManipulatorData& data, int j) {
+  if (model.getConvention() == DHConvention::Modified) return data.linkTransforms[static_cast<std::size_t>(j)];
+  return j == 0 ? model.getBaseTransform() : data.linkTransforms[static_cast<std::size_t>(j - 1)];
+}
+
+// The base-frame Jacobian into data.jacobian from the link frames of the last forward kinematics.
+void jacobianFromKinematics(const ManipulatorModel& model, ManipulatorData& data);
+
+}  // namespace rp::internal

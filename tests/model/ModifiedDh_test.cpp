@@ -1,0 +1,92 @@
+// Modified (Craig) DH: a modified-DH description of a standard-DH robot, derived by hand
+// (ModifiedDh.hpp), gives the same end-effector pose, Jacobians, torques, mass matrix and forward
+// dynamics as the standard one on seeded random configurations (the algorithms take different
+// paths for the two conventions). KDL agreement is in Kdl_test.cpp.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+
+#include "ModifiedDh.hpp"
+#include "rp/model/Dynamics.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/model/Puma560Model.hpp"
+#include "rp/model/UrdfModel.hpp"
+#include "rp/model/WAMModel.hpp"
+
+namespace rp {
+namespace {
+
+double maxDiff(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) { return (a - b).cwiseAbs().maxCoeff(); }
+
+void compare(const ManipulatorModel& standard, int trials, bool withTipWrench = true) {
+  const std::unique_ptr<ManipulatorModel> modified = test::toModifiedDh(standard);
+  ASSERT_EQ(modified->getConvention(), DHConvention::Modified);
+  const int n = standard.getNumberOfJoints();
+  ManipulatorData a(standard), b(*modified);
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> u(0, 1);
+  DynamicsOptions all;
+  all.motorInertia = true;
+  all.friction = true;
+  if (withTipWrench)
+    for (int i = 0; i < 6; ++i) all.tipWrench(i) = 0.5 * (i + 1);
+  for (int trial = 0; trial < trials; ++trial) {
+    JointVector q(n), qd(n), qdd(n), tau(n);
+    for (int i = 0; i < n; ++i) {
+      q(i) = standard.getPositionMin()(i) + u(rng) * (standard.getPositionMax()(i) - standard.getPositionMin()(i));
+      qd(i) = 4 * u(rng) - 2;
+      qdd(i) = 6 * u(rng) - 3;
+      tau(i) = 20 * u(rng) - 10;
+    }
+    ASSERT_LT(maxDiff(forwardKinematics(standard, a, q), forwardKinematics(*modified, b, q)), 1e-9) << trial;
+    ASSERT_LT(maxDiff(jacobian(standard, a, q), jacobian(*modified, b, q)), 1e-9) << trial;
+    ASSERT_LT(maxDiff(jacobian(standard, a, q, ReferenceFrame::EndEffector),
+                      jacobian(*modified, b, q, ReferenceFrame::EndEffector)),
+              1e-9);
+    ASSERT_LT(maxDiff(inverseDynamics(standard, a, q, qd, qdd), inverseDynamics(*modified, b, q, qd, qdd)), 1e-9);
+    // The tip wrench acts at link frame n, which is the same frame in both conventions when the
+    // last link has a = alpha = 0 (the Puma's and the WAM's).
+    ASSERT_LT(maxDiff(inverseDynamics(standard, a, q, qd, qdd, all), inverseDynamics(*modified, b, q, qd, qdd, all)),
+              1e-9);
+    JointVector g1(n), g2(n), c1(n), c2(n);
+    gravityTorque(standard, a, q, g1);
+    gravityTorque(*modified, b, q, g2);
+    ASSERT_LT(maxDiff(g1, g2), 1e-9);
+    coriolisTorque(standard, a, q, qd, c1);
+    coriolisTorque(*modified, b, q, qd, c2);
+    ASSERT_LT(maxDiff(c1, c2), 1e-9);
+    ASSERT_LT(maxDiff(massMatrix(standard, a, q, true), massMatrix(*modified, b, q, true)), 1e-9);
+    ASSERT_LT(maxDiff(forwardDynamics(standard, a, q, qd, tau, all), forwardDynamics(*modified, b, q, qd, tau, all)),
+              1e-8);
+  }
+}
+
+TEST(ModifiedDh, Puma560SameAsStandard) { compare(Puma560Model(), 1000); }
+
+TEST(ModifiedDh, Wam7SameAsStandard) { compare(WAM7Model(), 1000); }
+
+TEST(ModifiedDh, PrismaticArmSameAsStandard) {
+  UrdfOptions o;
+  o.tip = "tool";
+  const std::unique_ptr<ManipulatorModel> arm = loadUrdf(std::string(RP_TEST_DATA_DIR) + "/prismatic_arm.urdf", o);
+  // Its last DH link has a non-zero a or alpha, so link frame n (where a tip wrench acts) differs
+  // between the conventions: compare without one.
+  compare(*arm, 1000, false);
+}
+
+TEST(ModifiedDh, PumaModifiedParametersAreCraigs) {
+  // The derived parameters: a_{i-1}, alpha_{i-1} of the standard table shifted down one link.
+  const Puma560Model puma;
+  const std::unique_ptr<ManipulatorModel> m = test::toModifiedDh(puma);
+  EXPECT_EQ(m->getLink(0).a, 0.0);
+  EXPECT_EQ(m->getLink(0).alpha, 0.0);
+  EXPECT_DOUBLE_EQ(m->getLink(1).alpha, puma.getLink(0).alpha);
+  EXPECT_DOUBLE_EQ(m->getLink(2).a, 0.4318);
+  EXPECT_DOUBLE_EQ(m->getLink(3).a, 0.0203);
+  EXPECT_DOUBLE_EQ(m->getLink(2).d, 0.15005);
+  EXPECT_DOUBLE_EQ(m->getLink(3).d, 0.4318);
+}
+
+}  // namespace
+}  // namespace rp
