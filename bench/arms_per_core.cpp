@@ -1,0 +1,227 @@
+// How many simulated Puma 560 arms one core runs at 1 kHz in real time.
+//
+// The whole process is pinned to one CPU (--cpu, default 1), so every arm's servo thread shares
+// that core. Each arm is a Puma560 in simulation mode on the real clock: its own ControlProgram
+// thread (SCHED_FIFO priority 27 when permitted) runs the full servo cycle every 1 ms - a
+// setpoint from a trajectory generator (a slow sinusoid on joints 1-3), DefaultPositionControl
+// with gravity compensation, the limit checks, the forward dynamics and integration of the
+// simulation step, the lock-free state publication. For a number of arms N the program runs all
+// N for --seconds (default 5) after a one-second warm-up and counts the deadlines missed
+// (a cycle that ended after its next deadline) in that window. N doubles from --start (default
+// 16) until a deadline is missed, then a bisection finds the largest N with zero overruns (to
+// within --resolution arms, default 4). A count passes when one of --tries trials (default 3)
+// has no overrun (a shared machine stalls now and then; a count beyond capacity fails every
+// trial). Output: one line per trial, then the result
+//   arms_per_core N  cycle_p50_us A  cycle_p99_us X  wakeup_p99_us Y  wakeup_max_us Z
+//   cpu_us_per_arm_cycle C  scheduling S
+// where cycle_p50/p99 are the largest of the arms' median / 99th-percentile computation times
+// (one servo cycle, timed by its ControlProgram), the wake-up figures how late the threads ran
+// after their deadlines (the last arm of a period waits for the others: this is what runs out at
+// the limit), and cpu_us_per_arm_cycle the process's CPU time per arm cycle (cycle, thread
+// switch and timer wake-up).
+//
+// Usage: arms_per_core [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
+#include <sched.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rp/RoboticPlatform.hpp"
+
+namespace {
+
+using namespace rp;
+
+// A slow sinusoid (0.1 rad, 0.5 Hz) about the home position on joints 1-3, with its velocity.
+class Sinusoid : public TrajectoryGenerator {
+ public:
+  explicit Sinusoid(const JointVector& home) : home_(home) {}
+  ~Sinusoid() override { releaseFromManipulators(); }
+  bool getCurrentSetpoint(double time, Setpoint& sp) override {
+    if (t0_ < 0) t0_ = time;
+    const double w = 2 * 3.14159265358979 * 0.5, t = time - t0_;
+    sp.position = home_;
+    sp.velocity.setZero();
+    for (int i = 0; i < 3; ++i) {
+      sp.position(i) += 0.1 * std::sin(w * t);
+      sp.velocity(i) = 0.1 * w * std::cos(w * t);
+    }
+    return true;
+  }
+
+ private:
+  JointVector home_;
+  double t0_ = -1;
+};
+
+struct Trial {
+  int arms = 0;
+  std::uint64_t overruns = 0, cycles = 0;
+  double cycleP50 = 0, cycleP99 = 0, wakeupP99 = 0, wakeupMax = 0;
+  double cpuPerCycle = 0;  // process CPU time (user + system) per arm cycle in the window [us]
+  bool realTime = false;
+  bool errors = false;
+};
+
+double cpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+Trial run(int n, double seconds) {
+  Trial result;
+  result.arms = n;
+  std::vector<std::unique_ptr<Puma560>> arms;
+  std::vector<std::unique_ptr<Sinusoid>> generators;
+  arms.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    arms.push_back(std::make_unique<Puma560>("arm" + std::to_string(i)));
+    generators.push_back(std::make_unique<Sinusoid>(arms.back()->getModel().getHomePosition()));
+    arms.back()->setTrajectoryGenerator(*generators.back());
+  }
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // warm-up, not counted
+  std::vector<std::uint64_t> overruns0, cycles0;
+  for (const auto& a : arms) {
+    const ControlStatistics s = a->getStatistics();
+    overruns0.push_back(s.overruns);
+    cycles0.push_back(s.cycles);
+  }
+  const double cpu0 = cpuSeconds();
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  const double cpu1 = cpuSeconds();
+  for (std::size_t i = 0; i < arms.size(); ++i) {
+    const ControlStatistics s = arms[i]->getStatistics();
+    result.overruns += s.overruns - overruns0[i];
+    result.cycles += s.cycles - cycles0[i];
+    result.cycleP50 = std::max(result.cycleP50, s.computationTime.p50);
+    result.cycleP99 = std::max(result.cycleP99, s.computationTime.p99);
+    result.wakeupP99 = std::max(result.wakeupP99, s.wakeupLatency.p99);
+    result.wakeupMax = std::max(result.wakeupMax, s.wakeupLatency.max);
+    result.realTime = s.realTimeScheduling;
+    if (arms[i]->getErrorCode() != 0) {
+      result.errors = true;
+      std::fprintf(stderr, "arm %zu: %s\n", i, arms[i]->getErrorStatus().message.c_str());
+    }
+  }
+  result.cpuPerCycle = result.cycles > 0 ? 1e6 * (cpu1 - cpu0) / static_cast<double>(result.cycles) : 0;
+  generators.clear();
+  arms.clear();
+  return result;
+}
+
+void print(const Trial& t, double seconds) {
+  const double expected = t.arms * seconds * 1000.0;
+  std::printf("N %4d  overruns %6llu  cycles %.1f %%  cycle_p50_us %5.1f  cycle_p99_us %6.1f  wakeup_p99_us %7.1f  "
+              "wakeup_max_us %8.1f  cpu_us_per_arm_cycle %5.2f%s\n",
+              t.arms, static_cast<unsigned long long>(t.overruns), 100.0 * static_cast<double>(t.cycles) / expected,
+              t.cycleP50, t.cycleP99, t.wakeupP99, t.wakeupMax, t.cpuPerCycle, t.errors ? "  (arm errors)" : "");
+  std::fflush(stdout);
+}
+
+bool good(const Trial& t) { return t.overruns == 0 && !t.errors; }
+
+// A count passes if one of `tries` trials has no overrun: on a shared machine a single trial can
+// miss a deadline from a stall outside the process (the host, another process's interrupt), while
+// a count beyond the core's capacity misses deadlines every time.
+Trial attempt(int n, double seconds, int tries) {
+  Trial t;
+  for (int k = 0; k < tries; ++k) {
+    t = run(n, seconds);
+    print(t, seconds);
+    if (good(t)) break;
+  }
+  return t;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int cpu = 1, start = 16, max = 4096, resolution = 4, tries = 3;
+  double seconds = 5;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "arms_per_core: %s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--cpu") {
+      cpu = std::atoi(value());
+    } else if (a == "--seconds") {
+      seconds = std::atof(value());
+    } else if (a == "--start") {
+      start = std::atoi(value());
+    } else if (a == "--max") {
+      max = std::atoi(value());
+    } else if (a == "--tries") {
+      tries = std::max(1, std::atoi(value()));
+    } else if (a == "--resolution") {
+      resolution = std::max(1, std::atoi(value()));
+    } else {
+      std::fprintf(stderr,
+                   "usage: arms_per_core [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
+      return 2;
+    }
+  }
+  if (start < 1 || seconds <= 0) {
+    std::fprintf(stderr, "arms_per_core: --start must be >= 1 and --seconds > 0\n");
+    return 2;
+  }
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  if (sched_setaffinity(0, sizeof set, &set) != 0) {
+    std::fprintf(stderr, "arms_per_core: cannot pin to CPU %d: %s\n", cpu, std::strerror(errno));
+    return 1;
+  }
+  RoboticPlatform::setSimulationModeOn();  // real clock (the default), simulated arms
+
+  std::printf("simulated Puma 560 arms at 1 kHz on CPU %d, %.1f s per trial\n", cpu, seconds);
+  Trial best;
+  int bad = 0;
+  for (int n = start; n <= max; n *= 2) {
+    const Trial t = attempt(n, seconds, tries);
+    if (!good(t)) {
+      bad = n;
+      break;
+    }
+    best = t;
+  }
+  if (bad == 0) {
+    std::printf("no overrun up to --max %d\n", max);
+  } else {
+    int lo = best.arms, hi = bad;  // lo good (0: none), hi bad
+    while (hi - lo > resolution) {
+      const int mid = lo + (hi - lo) / 2;
+      const Trial t = attempt(mid, seconds, tries);
+      if (good(t)) {
+        lo = mid;
+        best = t;
+      } else {
+        hi = mid;
+      }
+    }
+  }
+  if (best.arms == 0) {
+    std::printf("arms_per_core 0 (even %d arms missed deadlines)\n", start);
+    return 0;
+  }
+  std::printf("arms_per_core %d  cycle_p50_us %.1f  cycle_p99_us %.1f  wakeup_p99_us %.1f  wakeup_max_us %.1f  "
+              "cpu_us_per_arm_cycle %.2f  scheduling %s\n",
+              best.arms, best.cycleP50, best.cycleP99, best.wakeupP99, best.wakeupMax, best.cpuPerCycle,
+              best.realTime ? "SCHED_FIFO" : "normal");
+  return 0;
+}
