@@ -1,6 +1,7 @@
 // Manipulators in simulation mode on the platform's simulated clock: holding under gravity
-// compensation, step tracking, switching servo controls, each kind of limit violation, two arms
-// at once, determinism, zero-gravity mode, and an allocation-free servo cycle.
+// compensation, switching servo controls mid-motion between two cycles, each kind of limit
+// violation shutting down in the cycle it happens, two arms at once, determinism, zero-gravity
+// mode, and an allocation-free servo cycle. (Step and trajectory tracking: Tracking_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -112,34 +113,7 @@ TEST_F(ManipulatorTest, GravityCompensationAloneHoldsRandomPosesAtRest) {
   }
 }
 
-TEST_F(ManipulatorTest, StepResponseSettlesWithLittleOvershoot) {
-  Puma560 puma;
-  JointVector target = puma.getModel().getHomePosition();
-  const double step = 0.02;  // [rad] small enough to stay below the torque limits
-  for (int i = 0; i < 6; ++i) target(i) += step;
-  StepGenerator gen(target, 0.0);
-  DefaultPositionControl& pid = puma.getDefaultPositionControl();
-  Probe probe(pid, 2000);
-  probe.trackOvershoot(target);
-  puma.setServoControl(probe);
-  puma.setTrajectoryGenerator(gen);
-  ASSERT_TRUE(puma.waitForCycles(2500));
-  ASSERT_TRUE(probe.recorded());
-  // Bounds: the PD part alone balances Coulomb friction F_c anywhere within F_c / K_p of the
-  // target (the dead band of a PD against dry friction); the integral can only shrink the error
-  // further, so after 2 s each joint is inside that band. The design is critically damped
-  // (omega_n = 25 rad/s); the integral and the coupling between joints may add overshoot, bounded
-  // here by 20 % of the step.
-  const ManipulatorModel& model = puma.getModel();
-  for (int i = 0; i < 6; ++i) {
-    const LinkParameters& l = model.getLink(i);
-    const double deadBand = std::abs(l.gearRatio) * std::max(l.coulombFrictionPositive, -l.coulombFrictionNegative) /
-                            pid.getKp()(i);
-    EXPECT_NEAR(probe.recorded_(i), target(i), deadBand) << "joint " << i + 1;
-    EXPECT_LT(probe.overshoot_(i), 0.2 * step) << "joint " << i + 1;
-  }
-  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
-}
+// Step and trajectory tracking with derived bounds: Tracking_test.cpp.
 
 // Outputs a constant torque on one joint.
 class ConstantTorque : public ServoControl {
@@ -173,16 +147,6 @@ TEST_F(ManipulatorTest, TorqueLimitViolationShutsTheSystemDown) {
   EXPECT_FALSE(puma.isArmPowerOn());
 }
 
-TEST_F(ManipulatorTest, VelocityLimitViolationShutsTheSystemDown) {
-  Puma560 puma;
-  ConstantTorque spin(5, 20.0);  // joint 6: light, within its 25 N m limit, speeds past 4 rad/s
-  puma.setGravityCompensationOn();
-  puma.setServoControl(spin);
-  ASSERT_TRUE(ObjectManager::waitForShutdown(10));
-  EXPECT_NE(puma.getErrorStatus().message.find("joint 6 velocity"), std::string::npos)
-      << puma.getErrorStatus().message;
-}
-
 // Moves joint `joint` at a constant speed from the home position.
 class RampGenerator : public TrajectoryGenerator {
  public:
@@ -203,17 +167,6 @@ class RampGenerator : public TrajectoryGenerator {
   double speed_;
   double t0_ = -1;
 };
-
-TEST_F(ManipulatorTest, PositionLimitViolationShutsTheSystemDown) {
-  simClock().pause();
-  Puma560 puma;
-  RampGenerator gen(puma.getModel().getHomePosition(), 4, 1.0);  // joint 5 towards its 100 degree limit
-  puma.setTrajectoryGenerator(gen);
-  simClock().resume();
-  ASSERT_TRUE(ObjectManager::waitForShutdown(10));
-  EXPECT_NE(puma.getErrorStatus().message.find("joint 5 position"), std::string::npos)
-      << puma.getErrorStatus().message;
-}
 
 TEST_F(ManipulatorTest, ViolationIsDetectedInTheCycleItHappens) {
   // The probe counts the cycles in which the torque servo control ran: exactly one, because the
@@ -243,23 +196,124 @@ TEST_F(ManipulatorTest, ViolationIsDetectedInTheCycleItHappens) {
   EXPECT_EQ(counter.calls.load(), 1);
 }
 
+// Wraps a servo control and counts its cycles; records the first cycle in which the state it is
+// given (the state the limit check of the same cycle sees) has joint `joint` past its velocity
+// limit (kind 'v') or its upper position limit (kind 'p').
+class FirstExcess : public ServoControl {
+ public:
+  FirstExcess(ServoControl& inner, char kind, int joint) : inner_(inner), kind_(kind), joint_(joint) {}
+  ~FirstExcess() override { releaseFromManipulator(); }
+  void attach(Manipulator& m) override {
+    ServoControl::attach(m);
+    if (inner_.getManipulator() != &m) inner_.attach(m);
+  }
+  void calculate() override {
+    const int call = calls.load() + 1;
+    const ManipulatorModel& model = d_manipulator->getModel();
+    const bool past = kind_ == 'v' ? std::abs(d_manipulator->getJointVelocity()(joint_)) > model.getVelocityLimit()(joint_)
+                                   : d_manipulator->getJointPosition()(joint_) > model.getPositionMax()(joint_);
+    if (past && first.load() == 0) first.store(call);
+    calls.store(call);
+    inner_.calculate();
+  }
+  std::atomic<int> calls{0}, first{0};
+
+ private:
+  ServoControl& inner_;
+  char kind_;
+  int joint_;
+};
+
+// The servo control ran in every cycle up to and including the first one past the limit and in
+// none after it (that cycle's check switched to the damped hold and requested the shutdown); the
+// error names the joint and the kind; the shutdown completes with the power off.
+void expectShutdownInTheCycleOfTheExcess(Puma560& puma, const FirstExcess& watch, const std::string& what) {
+  ASSERT_TRUE(ObjectManager::waitForShutdown(10));
+  puma.waitForCycles(100);
+  EXPECT_GT(watch.first.load(), 1);
+  EXPECT_EQ(watch.calls.load(), watch.first.load());
+  EXPECT_NE(puma.getErrorStatus().message.find(what), std::string::npos) << puma.getErrorStatus().message;
+  for (int i = 0; i < 10000 && !puma.isShutdownComplete(); ++i) puma.waitForCycles(1, 1);
+  EXPECT_TRUE(puma.isShutdownComplete());
+  EXPECT_FALSE(puma.isArmPowerOn());
+}
+
+TEST_F(ManipulatorTest, VelocityViolationIsDetectedInTheCycleItHappens) {
+  Puma560 puma;
+  ConstantTorque spin(5, 20.0);
+  FirstExcess watch(spin, 'v', 5);
+  simClock().pause();
+  puma.setServoControl(watch);
+  simClock().resume();
+  expectShutdownInTheCycleOfTheExcess(puma, watch, "joint 6 velocity");
+}
+
+TEST_F(ManipulatorTest, PositionViolationIsDetectedInTheCycleItHappens) {
+  simClock().pause();
+  Puma560 puma;
+  RampGenerator gen(puma.getModel().getHomePosition(), 4, 1.0);  // joint 5 towards its upper limit
+  FirstExcess watch(puma.getDefaultPositionControl(), 'p', 4);
+  puma.setServoControl(watch);
+  puma.setTrajectoryGenerator(gen);
+  simClock().resume();
+  expectShutdownInTheCycleOfTheExcess(puma, watch, "joint 5 position");
+}
+
+// Wraps a servo control and records the first and last servo cycles it ran in, and the speed of
+// joint 1 in its first cycle.
+class CycleSpan : public ServoControl {
+ public:
+  explicit CycleSpan(ServoControl& inner) : inner_(inner) {}
+  ~CycleSpan() override { releaseFromManipulator(); }
+  void attach(Manipulator& m) override {
+    ServoControl::attach(m);
+    if (inner_.getManipulator() != &m) inner_.attach(m);
+  }
+  void activate() override { inner_.activate(); }
+  void calculate() override {
+    const auto cycle = static_cast<long>(dynamic_cast<DefaultManipulator&>(*d_manipulator).getCycleCount());
+    if (first.load() < 0) {
+      firstSpeed.store(std::abs(d_manipulator->getJointVelocity()(0)));
+      first.store(cycle);
+    }
+    last.store(cycle);
+    inner_.calculate();
+  }
+  std::atomic<long> first{-1}, last{-1};
+  std::atomic<double> firstSpeed{0};
+
+ private:
+  ServoControl& inner_;
+};
+
 TEST_F(ManipulatorTest, ServoControlsSwitchMidMotion) {
+  // A step on joint 1 under the default control; 30 cycles in, with the joint moving, a stiffer
+  // PID takes over. The switch happens between two cycles: the new control's first cycle is the
+  // one right after the old control's last, no cycle is skipped or run by both.
   Puma560 puma;
   JointVector target = puma.getModel().getHomePosition();
   target(0) += 0.02;
   StepGenerator gen(target, 0.0);
+  CycleSpan before(puma.getDefaultPositionControl());
+  simClock().pause();
+  puma.setServoControl(before);
   puma.setTrajectoryGenerator(gen);
-  ASSERT_TRUE(puma.waitForCycles(30));  // in motion
+  ASSERT_TRUE(puma.runCycles(30));  // in motion
   DefaultPositionControl stiffer;
   stiffer.attach(puma);
   JointVector kp = stiffer.getKp() * 2.0, kd = stiffer.getKd() * 1.5, ki = stiffer.getKi();
   stiffer.setGains(kp, kd, ki);
-  puma.setServoControl(stiffer);
+  CycleSpan after(stiffer);
+  puma.setServoControl(after);
+  simClock().resume();
   ASSERT_TRUE(puma.waitForCycles(2000));
-  EXPECT_EQ(&puma.getServoControl(), &stiffer);
-  // Within the Coulomb-friction dead band of the new proportional gain (see the step test).
+  EXPECT_EQ(&puma.getServoControl(), &after);
+  EXPECT_EQ(after.first.load(), before.last.load() + 1) << "taken over between two consecutive cycles";
+  EXPECT_GT(after.firstSpeed.load(), 0.01) << "joint 1 was moving at the switch [rad/s]";
+  // Within the Coulomb-friction dead band of the new proportional gain (see Tracking_test.cpp).
   const LinkParameters& l = puma.getModel().getLink(0);
-  EXPECT_NEAR(puma.getJointPosition()(0), target(0), std::abs(l.gearRatio) * 0.435 / kp(0));
+  const double fc = std::abs(l.gearRatio) * std::max(l.coulombFrictionPositive, -l.coulombFrictionNegative);
+  EXPECT_NEAR(puma.getJointPosition()(0), target(0), fc / kp(0));
   EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
 }
 
@@ -286,6 +340,9 @@ TEST_F(ManipulatorTest, TwoArmsRunTogetherDeterministically) {
     while (!pa.recorded() || !pb.recorded()) first.waitForCycles(10);
     a = pa.recorded_;
     b = pb.recorded_;
+    // Each arm follows its own step (0.7 s in, past half-way to its 0.01 rad step).
+    EXPECT_NEAR(a(1), ta(1), 0.005);
+    EXPECT_NEAR(b(0), tb(0), 0.005);
     EXPECT_EQ(first.getErrorCode(), 0) << first.getErrorStatus().message;
     EXPECT_EQ(second.getErrorCode(), 0) << second.getErrorStatus().message;
   };
