@@ -2,12 +2,16 @@
 // compensation), forward dynamics with motor inertia and viscous friction, and one semi-implicit
 // Euler step of 1 ms, through ManipulatorSimulation; next to MuJoCo stepping the same arm, which
 // this program writes in MJCF from the same model (same DH frames, masses, centres of mass,
-// inertias, armature G^2 Jm, viscous damping B G^2; no contacts, no Coulomb friction on either
-// side, timestep 1 ms, integrator Euler (MuJoCo's is semi-implicit with implicit damping)). The
-// same control torques are computed for both with our gravity routine.
+// inertias, armature G^2 Jm, viscous damping B G^2; no contacts, timestep 1 ms, integrator Euler
+// (MuJoCo's is semi-implicit with implicit damping)). Our step also applies the model's Coulomb
+// friction as a velocity impulse (a few nanoseconds); MuJoCo gets none. The same control torques
+// are computed for both with our gravity routine. A second MuJoCo variant has no damping
+// attribute and gets the viscous torque as an applied force, so that both sides take the same
+// semi-implicit Euler step with explicit damping. Part_* entries time the pieces (our gravity
+// torque and forward dynamics, mj_step alone).
 //
-// Also: how many simulated Puma arms one core could run at 1 kHz in real time, from the
-// measured cycle time (reported as the counter arms_per_core).
+// The counter arms_per_core of ServoCycle_rp is 1 ms over the cycle time: an upper bound with no
+// thread switches or wake-ups; bench/arms_per_core measures arms per core in real time.
 #include <benchmark/benchmark.h>
 
 #include <mujoco/mujoco.h>
@@ -28,7 +32,9 @@ using namespace rp;
 // MJCF for a standard-DH model: body k sits at frame k-1 and turns about its z axis; link k's
 // inertia lives in frame k = Rz(q_k) M_k with M_k = Tz(d) Tx(a) Rx(alpha), so it is given at
 // M_k * com with the rotated inertia tensor, and body k+1 is placed at M_k.
-std::string mjcf(const ManipulatorModel& model) {
+// With `damping` false the joints get no damping attribute (the benchmark then applies the viscous
+// friction itself, explicitly, as ManipulatorSimulation does).
+std::string mjcf(const ManipulatorModel& model, bool damping = true) {
   std::ostringstream x;
   x.precision(17);
   // balanceinertia: the Puma's link 1 (Ixx = Izz = 0, Iyy = 0.35) breaks MuJoCo's triangle
@@ -46,7 +52,7 @@ std::string mjcf(const ManipulatorModel& model) {
       << "\" quat=\"" << qp.w() << " " << qp.x() << " " << qp.y() << " " << qp.z() << "\">\n";
     const double G = l.gearRatio;
     x << "<joint name=\"j" << k + 1 << "\" type=\"hinge\" axis=\"0 0 1\" armature=\"" << G * G * l.motorInertia
-      << "\" damping=\"" << l.viscousFriction * G * G << "\"/>\n";
+      << "\" damping=\"" << (damping ? l.viscousFriction * G * G : 0.0) << "\"/>\n";
     const Eigen::Vector3d c = M.topLeftCorner<3, 3>() * Eigen::Vector3d(l.com) + M.topRightCorner<3, 1>();
     const Eigen::Matrix3d I = M.topLeftCorner<3, 3>() * Eigen::Matrix3d(l.inertia) * M.topLeftCorner<3, 3>().transpose();
     const double mass = l.mass > 0 ? l.mass : 1e-6;  // MuJoCo needs mass on a moving body
@@ -60,13 +66,37 @@ std::string mjcf(const ManipulatorModel& model) {
   return x.str();
 }
 
+// A MuJoCo model and data loaded from the MJCF the benchmark writes.
+struct MuJoCoArm {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  MuJoCoArm(const ManipulatorModel& model, bool damping) {
+    const std::string path =
+        "/tmp/rp_simulation_bench_" + model.getName() + (damping ? "" : "_undamped") + ".xml";
+    if (FILE* f = std::fopen(path.c_str(), "w")) {
+      const std::string xml = mjcf(model, damping);
+      std::fputs(xml.c_str(), f);
+      std::fclose(f);
+    }
+    char error[1000] = "";
+    m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
+    if (m == nullptr) throw std::runtime_error(std::string("MuJoCo: ") + error);
+    d = mj_makeData(m);
+    for (int i = 0; i < model.getNumberOfJoints(); ++i) d->qpos[i] = model.getHomePosition()(i);
+  }
+  ~MuJoCoArm() {
+    mj_deleteData(d);
+    mj_deleteModel(m);
+  }
+};
+
 struct Arm {
   std::unique_ptr<ManipulatorModel> model;
   std::unique_ptr<ManipulatorData> data;
   std::unique_ptr<ManipulatorSimulation> sim;
-  JointVector target, kp, kd, g, tau;
-  mjModel* m = nullptr;
-  mjData* d = nullptr;
+  JointVector target, kp, kd, g, tau, viscous;
+  std::unique_ptr<MuJoCoArm> mujoco;          // damping as a joint attribute (MuJoCo integrates it implicitly)
+  std::unique_ptr<MuJoCoArm> mujocoExplicit;  // no damping attribute: viscous friction applied as a force
 
   explicit Arm(std::unique_ptr<ManipulatorModel> mm) : model(std::move(mm)) {
     data = std::make_unique<ManipulatorData>(*model);
@@ -78,27 +108,16 @@ struct Arm {
       const double middle = 0.5 * (model->getPositionMin()(i) + model->getPositionMax()(i));
       target(i) += target(i) < middle ? 0.1 : -0.1;
     }
-    kp = kd = g = tau = JointVector(n);
+    kp = kd = g = tau = viscous = JointVector(n);
     const JointMatrix& M = massMatrix(*model, *data, model->getHomePosition(), true);
     for (int i = 0; i < n; ++i) {
       kp(i) = M(i, i) * 625;
       kd(i) = M(i, i) * 50;
+      const LinkParameters& l = model->getLink(i);
+      viscous(i) = l.viscousFriction * l.gearRatio * l.gearRatio;
     }
-    const std::string path = "/tmp/rp_simulation_bench_" + model->getName() + ".xml";
-    if (FILE* f = std::fopen(path.c_str(), "w")) {
-      const std::string xml = mjcf(*model);
-      std::fputs(xml.c_str(), f);
-      std::fclose(f);
-    }
-    char error[1000] = "";
-    m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
-    if (m == nullptr) throw std::runtime_error(std::string("MuJoCo: ") + error);
-    d = mj_makeData(m);
-    for (int i = 0; i < n; ++i) d->qpos[i] = model->getHomePosition()(i);
-  }
-  ~Arm() {
-    mj_deleteData(d);
-    mj_deleteModel(m);
+    mujoco = std::make_unique<MuJoCoArm>(*model, true);
+    mujocoExplicit = std::make_unique<MuJoCoArm>(*model, false);
   }
   // The control law: PD towards the target plus gravity compensation.
   void control(const JointVector& q, const JointVector& qd) {
@@ -122,28 +141,73 @@ void ServoCycle_rp(benchmark::State& s) {
     a.sim->step(a.tau, 1e-3);
     benchmark::DoNotOptimize(a.sim->getPosition().data());
   }
-  // Arms one core could simulate at 1 kHz: 1 ms divided by the time of one cycle.
+  // Arms one core could simulate at 1 kHz if nothing but this cycle ran (no thread switches or
+  // timer wake-ups; bench/arms_per_core measures those in real time): 1 ms / cycle time.
   s.counters["arms_per_core"] = benchmark::Counter(1e-3, benchmark::Counter::kIsIterationInvariantRate);
 }
 
-void ServoCycle_MuJoCo(benchmark::State& s) {
+// The same control law around mj_step. `explicitDamping`: the model has no damping attribute and
+// the viscous friction -B G^2 qd is added to the applied force, so that MuJoCo's Euler step is the
+// plain semi-implicit Euler step ManipulatorSimulation takes (with a damping attribute MuJoCo
+// integrates damping implicitly, which costs it a second factorisation of M + h D).
+void mujocoCycle(benchmark::State& s, bool explicitDamping) {
   Arm& a = arm(s);
+  MuJoCoArm& mj = explicitDamping ? *a.mujocoExplicit : *a.mujoco;
   const int n = a.model->getNumberOfJoints();
   JointVector q(n), qd(n);
   for (auto _ : s) {
     for (int i = 0; i < n; ++i) {
-      q(i) = a.d->qpos[i];
-      qd(i) = a.d->qvel[i];
+      q(i) = mj.d->qpos[i];
+      qd(i) = mj.d->qvel[i];
     }
     a.control(q, qd);
-    for (int i = 0; i < n; ++i) a.d->qfrc_applied[i] = a.tau(i);
-    mj_step(a.m, a.d);
-    benchmark::DoNotOptimize(a.d->qpos);
+    for (int i = 0; i < n; ++i) mj.d->qfrc_applied[i] = a.tau(i) - (explicitDamping ? a.viscous(i) * qd(i) : 0.0);
+    mj_step(mj.m, mj.d);
+    benchmark::DoNotOptimize(mj.d->qpos);
+  }
+}
+
+void ServoCycle_MuJoCo(benchmark::State& s) { mujocoCycle(s, false); }
+void ServoCycle_MuJoCoExplicitDamping(benchmark::State& s) { mujocoCycle(s, true); }
+
+// The parts of our cycle: the control law's gravity torque, and the forward dynamics inside the
+// simulation step (M by centre-of-mass Jacobians, the bias torques by Newton-Euler, LDL^T).
+void Part_rpGravityTorque(benchmark::State& s) {
+  Arm& a = arm(s);
+  JointVector q = a.target;
+  for (auto _ : s) {
+    gravityTorque(*a.model, *a.data, q, a.g);
+    benchmark::DoNotOptimize(a.g.data());
+    q(0) += 1e-9;
+  }
+}
+
+void Part_rpForwardDynamics(benchmark::State& s) {
+  Arm& a = arm(s);
+  JointVector q = a.target, qd(a.model->getNumberOfJoints()), tau(a.model->getNumberOfJoints());
+  DynamicsOptions options;
+  options.motorInertia = true;
+  for (auto _ : s) {
+    benchmark::DoNotOptimize(forwardDynamics(*a.model, *a.data, q, qd, tau, options).data());
+    q(0) += 1e-9;
+  }
+}
+
+// mj_step alone (no control law around it).
+void Part_MuJoCoStep(benchmark::State& s) {
+  Arm& a = arm(s);
+  for (auto _ : s) {
+    mj_step(a.mujoco->m, a.mujoco->d);
+    benchmark::DoNotOptimize(a.mujoco->d->qpos);
   }
 }
 
 BENCHMARK(ServoCycle_rp)->Arg(6)->Arg(7);
 BENCHMARK(ServoCycle_MuJoCo)->Arg(6)->Arg(7);
+BENCHMARK(ServoCycle_MuJoCoExplicitDamping)->Arg(6)->Arg(7);
+BENCHMARK(Part_rpGravityTorque)->Arg(6)->Arg(7);
+BENCHMARK(Part_rpForwardDynamics)->Arg(6)->Arg(7);
+BENCHMARK(Part_MuJoCoStep)->Arg(6)->Arg(7);
 
 }  // namespace
 
