@@ -28,6 +28,9 @@ struct PlatformState {
   bool configFileGiven = false;
   std::string logFile;
   std::function<void()> guiStarter;
+  std::string guiAddress = "127.0.0.1";
+  std::string guiToken;
+  int guiPort = -1;  // -1: the viewer's default port (with fallback to the next free one)
   std::atomic<int> simulation{-1};  // -1 default (on), 0 -nosim, 1 -sim (forced)
   std::atomic<bool> gui{true};
   std::atomic<bool> qmotor{false};
@@ -61,6 +64,9 @@ std::string RoboticPlatform::usage() {
          "  -sim               simulation mode on for every object\n"
          "  -nosim             use the hardware (objects may still set simulationMode on)\n"
          "  -gui | -nogui      start the Scene Viewer or not (default: start it)\n"
+         "  -gui-address <ip>  address the Scene Viewer listens on (default 127.0.0.1)\n"
+         "  -gui-port <n>      its TCP port (default 7070 or the next free one; 0: any free port)\n"
+         "  -gui-token <text>  token pages must present (generated when the address is not loopback)\n"
          "  -config <file>     global configuration file (default: rp.cfg)\n"
          "  -qmotor            open the tuning window\n"
          "  -log <file>        log every log variable of every control program to one CSV file\n"
@@ -91,10 +97,26 @@ std::vector<std::string> RoboticPlatform::parseCommandLine(const std::vector<std
     else if (a == "-simclock") useSimulatedClock();
     else if (a == "-config") setConfigurationFileName(value("a file name"));
     else if (a == "-log") setLogFileName(value("a CSV file name"));
+    else if (a == "-gui-address") setGuiAddress(value("an IP address"));
+    else if (a == "-gui-token") setGuiToken(value("a token"));
+    else if (a == "-gui-port") {
+      const std::string v = value("a port number 0..65535");
+      std::size_t used = 0;
+      int port = -1;
+      try {
+        port = std::stoi(v, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != v.size() || port < 0 || port > 65535)
+        throw std::invalid_argument("switch '-gui-port' needs a port number 0..65535, not '" + v + "'");
+      setGuiPort(port);
+    }
     else if (a == "--help" || a == "-help" || a == "-h") throw std::invalid_argument("--help");
     else if (a.size() >= 2 && a[0] == '-' && a[1] != '-' && !(a[1] >= '0' && a[1] <= '9') && a[1] != '.')
       throw std::invalid_argument("unknown platform switch '" + a +
-                                  "' (known: -sim, -nosim, -gui, -nogui, -config, -qmotor, -log, -simclock, --help)");
+                                  "' (known: -sim, -nosim, -gui, -nogui, -gui-address, -gui-port, -gui-token, -config, -qmotor, -log, "
+                                  "-simclock, --help)");
     else
       rest.push_back(a);
   }
@@ -189,6 +211,37 @@ bool RoboticPlatform::isSimulationModeForced() { return state().simulation.load(
 void RoboticPlatform::setGuiOn() { state().gui = true; }
 void RoboticPlatform::setGuiOff() { state().gui = false; }
 bool RoboticPlatform::isGuiOn() { return state().gui.load(); }
+void RoboticPlatform::setGuiAddress(const std::string& address) {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  state().guiAddress = address;
+}
+
+std::string RoboticPlatform::getGuiAddress() {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  return state().guiAddress;
+}
+
+void RoboticPlatform::setGuiPort(int port) {
+  if (port < -1 || port > 65535) throw std::invalid_argument("RoboticPlatform::setGuiPort: port must be -1..65535");
+  std::lock_guard<std::mutex> lock(state().mutex);
+  state().guiPort = port;
+}
+
+int RoboticPlatform::getGuiPort() {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  return state().guiPort;
+}
+
+void RoboticPlatform::setGuiToken(const std::string& token) {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  state().guiToken = token;
+}
+
+std::string RoboticPlatform::getGuiToken() {
+  std::lock_guard<std::mutex> lock(state().mutex);
+  return state().guiToken;
+}
+
 void RoboticPlatform::setQMotorOn() { state().qmotor = true; }
 bool RoboticPlatform::isQMotorOn() { return state().qmotor.load(); }
 

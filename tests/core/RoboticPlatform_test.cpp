@@ -38,8 +38,8 @@ TEST(RoboticPlatform, SwitchErrors) {
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(),
-                 "unknown platform switch '-simm' (known: -sim, -nosim, -gui, -nogui, -config, -qmotor, -log, "
-                 "-simclock, --help)");
+                 "unknown platform switch '-simm' (known: -sim, -nosim, -gui, -nogui, -gui-address, -gui-port, "
+                 "-gui-token, -config, -qmotor, -log, -simclock, --help)");
   }
   try {
     RoboticPlatform::parseCommandLine({"-config"});

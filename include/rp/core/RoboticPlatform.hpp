@@ -21,6 +21,9 @@ class Clock;
 /// |---|---|---|
 /// | `-sim` / `-nosim` | simulation mode on/off for all objects | setSimulationModeOn() / setSimulationModeOff() |
 /// | `-gui` / `-nogui` | start the Scene Viewer or not | setGuiOn() / setGuiOff() |
+/// | `-gui-address <ip>` | address the Scene Viewer listens on (default 127.0.0.1) | setGuiAddress() |
+/// | `-gui-port <n>` | its TCP port (default 7070 or the next free one; 0: any free port) | setGuiPort() |
+/// | `-gui-token <text>` | token pages must present (generated for a non-loopback address) | setGuiToken() |
 /// | `-config <file>` | the global configuration file (default `rp.cfg`) | setConfigurationFileName() |
 /// | `-qmotor` | open the tuning window (QMotor's role) | setQMotorOn() |
 /// | `-log <file>` | log every log variable of every control program to one CSV file | setLogFileName() |
@@ -63,6 +66,23 @@ class RoboticPlatform {
   static void setGuiOff();
   /// Whether the Scene Viewer is to be started.
   static bool isGuiOn();
+  /// Sets the address the Scene Viewer listens on (`-gui-address`); any address other than a
+  /// loopback one makes the viewer require a token.
+  /// @param[in] address  IPv4 or IPv6 literal (default `127.0.0.1`)
+  static void setGuiAddress(const std::string& address);
+  /// The address the Scene Viewer listens on.
+  static std::string getGuiAddress();
+  /// Sets the Scene Viewer's TCP port (`-gui-port`).
+  /// @param[in] port  0..65535 (0: any free port), or -1 for the default (7070 or the next free one)
+  /// @throws std::invalid_argument if out of range
+  static void setGuiPort(int port);
+  /// The Scene Viewer's TCP port as set (-1: the default).
+  static int getGuiPort();
+  /// Sets the token pages must present (`-gui-token`); empty: none on loopback, generated otherwise.
+  /// @param[in] token  the token
+  static void setGuiToken(const std::string& token);
+  /// The token set with setGuiToken() (empty if none was given).
+  static std::string getGuiToken();
   /// Opens the tuning window (`-qmotor`).
   static void setQMotorOn();
   /// Whether the tuning window is to be opened.

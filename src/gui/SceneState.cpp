@@ -1,0 +1,295 @@
+// Scene description and binary state frames for the Scene Viewer (see SceneState.hpp).
+#include "SceneState.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include "rp/core/ObjectManager.hpp"
+#include "rp/effector/Gripper.hpp"
+#include "rp/gui/SceneViewer.hpp"
+#include "rp/manipulator/Manipulator.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/model/ManipulatorData.hpp"
+#include "rp/rt/ControlProgram.hpp"
+
+namespace rp::internal {
+
+namespace {
+
+using nlohmann::json;
+
+json transformJson(const Transform& t) {
+  json a = json::array();
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) a.push_back(t(r, c));  // column-major, as three.js Matrix4.fromArray
+  return a;
+}
+
+const char* shapeKindName(ShapeKind k) {
+  switch (k) {
+    case ShapeKind::Box: return "box";
+    case ShapeKind::Cylinder: return "cylinder";
+    case ShapeKind::Sphere: return "sphere";
+    case ShapeKind::Mesh: return "mesh";
+  }
+  return "box";
+}
+
+const char* displayName(DisplayMode m) {
+  switch (m) {
+    case DisplayMode::Off: return "off";
+    case DisplayMode::Solid: return "solid";
+    case DisplayMode::Wireframe: return "wireframe";
+  }
+  return "solid";
+}
+
+const char* fieldKindName(FieldKind k) {
+  switch (k) {
+    case FieldKind::Number: return "number";
+    case FieldKind::Vector: return "vector";
+    case FieldKind::Boolean: return "boolean";
+    case FieldKind::Text: return "text";
+    case FieldKind::Choice: return "choice";
+  }
+  return "number";
+}
+
+json vectorJson(const JointVector& v) {
+  json a = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
+  return a;
+}
+
+void put32(std::string& out, std::uint32_t v) {
+  char b[4];
+  for (int i = 0; i < 4; ++i) b[i] = static_cast<char>((v >> (8 * i)) & 0xffu);
+  out.append(b, 4);
+}
+
+void putDouble(std::string& out, double v) {
+  static_assert(sizeof(double) == 8);
+  std::uint64_t bits;
+  std::memcpy(&bits, &v, 8);
+  char b[8];
+  for (int i = 0; i < 8; ++i) b[i] = static_cast<char>((bits >> (8 * i)) & 0xffu);
+  out.append(b, 8);
+}
+
+void putTransform(std::string& out, const Transform& t) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) putDouble(out, t(r, c));
+}
+
+}  // namespace
+
+SceneState::SceneState() = default;
+SceneState::~SceneState() = default;
+
+json SceneState::describe(Entry& e) {
+  RoboticObject& o = *e.object;
+  json j;
+  j["path"] = "/objects/" + e.name;
+  j["name"] = e.name;
+  j["className"] = o.getClassName();
+  j["hasControlLoop"] = o.getControlProgram() != nullptr;
+  e.physical = dynamic_cast<PhysicalObject*>(&o);
+  e.manipulator = dynamic_cast<Manipulator*>(&o);
+  j["physical"] = e.physical != nullptr;
+  j["kind"] = e.manipulator ? "manipulator"
+              : dynamic_cast<Gripper*>(&o) ? "gripper"
+              : e.physical                 ? "physical"
+                                           : "functional";
+  ErrorStatus err = o.getErrorStatus();
+  j["error"] = {{"code", err.code}, {"message", err.message}};
+  json commands = json::array();
+  for (const CommandInfo& c : o.getCommands()) commands.push_back({{"name", c.name}, {"description", c.description}});
+  j["commands"] = commands;
+
+  ControlPanel panel = o.getControlPanel();
+  json fields = json::array();
+  ControlProgram* program = o.getControlProgram();
+  for (const ControlPanelField& f : panel.fields) {
+    json jf = {{"name", f.name},       {"label", f.label},       {"kind", fieldKindName(f.kind)},
+               {"size", f.size},       {"unit", f.unit},         {"min", f.min},
+               {"max", f.max},         {"tunable", f.tunable},   {"stateIndex", f.stateIndex},
+               {"choices", f.choices}};
+    if (f.tunable && program) {
+      try {
+        jf["value"] = program->getParameter(f.name);
+      } catch (const std::exception&) {
+        // a panel field that is not a parameter of the program: shown without a value
+      }
+    }
+    if (f.name == "errorCode") jf["value"] = std::vector<double>{static_cast<double>(err.code)};
+    fields.push_back(std::move(jf));
+  }
+  j["panel"] = {{"title", panel.title}, {"fields", fields}};
+  if (program) {
+    json logs = json::array();
+    for (const LogVariableInfo& v : program->getLogVariables()) logs.push_back({{"name", v.name}, {"size", v.size}, {"unit", v.unit}});
+    j["logVariables"] = logs;
+    j["rate"] = program->getRate();
+  }
+
+  e.frames.clear();
+  if (e.physical) {
+    Model3D m = e.physical->get3DModel();
+    e.frames = m.frames;
+    json shapes = json::array();
+    for (const Shape& s : m.shapes) {
+      shapes.push_back({{"kind", shapeKindName(s.kind)},
+                        {"frame", s.frame},
+                        {"pose", transformJson(s.pose)},
+                        {"size", {s.size(0), s.size(1), s.size(2)}},
+                        {"mesh", s.meshFile},
+                        {"color", {s.color.r, s.color.g, s.color.b, s.color.a}}});
+    }
+    j["frames"] = m.frames;
+    j["shapes"] = shapes;
+    j["display"] = displayName(e.physical->getDisplayMode());
+    if (PhysicalObject* mount = e.physical->getConnection())
+      j["connection"] = {{"object", mount->getName()}, {"frame", e.physical->getConnectionFrame()}};
+    else
+      j["connection"] = nullptr;
+  }
+  if (e.manipulator) {
+    const ManipulatorModel& model = e.manipulator->getModel();
+    if (!e.data) e.data = std::make_unique<ManipulatorData>(model);
+    j["joints"] = model.getNumberOfJoints();
+    j["qmin"] = vectorJson(model.getPositionMin());
+    j["qmax"] = vectorJson(model.getPositionMax());
+    j["vmax"] = vectorJson(model.getVelocityLimit());
+    j["home"] = vectorJson(model.getHomePosition());
+    j["servoRate"] = 1.0 / e.manipulator->getServoPeriod();
+  }
+  return j;
+}
+
+bool SceneState::refresh() {
+  std::set<RoboticObject*> present;
+  json objects = json::array();
+  ObjectManager().forEachObject([&](RoboticObject& o) {
+    present.insert(&o);
+    const std::string name = o.getName();  // safe at any time
+    auto it = entries_.find(&o);
+    if (it == entries_.end() || it->second.name != name) {
+      // New (or a new object at the address of a destroyed one): only recorded this time, since
+      // it may still be under construction.
+      Entry e;
+      e.object = &o;
+      e.name = name;
+      e.sightings = 1;
+      entries_[&o] = std::move(e);
+      return;
+    }
+    Entry& e = it->second;
+    ++e.sightings;
+    e.index = static_cast<int>(objects.size());
+    objects.push_back(describe(e));
+    e.described = true;
+  });
+  for (auto it = entries_.begin(); it != entries_.end();)
+    it = present.count(it->first) ? std::next(it) : entries_.erase(it);
+  std::string dump = objects.dump();
+  if (dump == lastObjects_ && !sceneMessage_.empty()) return false;
+  lastObjects_ = std::move(dump);
+  ++version_;
+  json msg = {{"type", "scene"}, {"protocol", kSceneViewerProtocolVersion}, {"version", version_}, {"objects", objects}};
+  sceneMessage_ = msg.dump();
+  return true;
+}
+
+std::string SceneState::buildFrame() {
+  // Layout (little-endian): u32 magic "RPS1", u32 protocol, u32 scene version, u32 object count,
+  // f64 time; per object: u32 index into the scene's objects, u32 frame count F, u32 value count V,
+  // u32 error code, F x 16 f64 world poses (column-major 4x4), V x f64 state values.
+  std::string out;
+  out.reserve(1024);
+  put32(out, kStateFrameMagic);
+  put32(out, static_cast<std::uint32_t>(kSceneViewerProtocolVersion));
+  put32(out, version_);
+  const std::size_t countAt = out.size();
+  put32(out, 0);
+  const std::size_t timeAt = out.size();
+  putDouble(out, 0);
+  std::uint32_t count = 0;
+  double time = 0;
+
+  ObjectManager().forEachObject([&](RoboticObject& o) {
+    auto it = entries_.find(&o);
+    if (it == entries_.end() || !it->second.described || it->second.index < 0) return;
+    Entry& e = it->second;
+    StateSnapshot snap;
+    const bool hasState = o.getStateSnapshot(snap);
+    if (hasState) time = std::max(time, snap.time);
+    std::vector<Transform> poses(e.frames.size(), Transform::unit());
+    if (e.manipulator && e.data) {
+      const ManipulatorModel& model = e.manipulator->getModel();
+      JointVector q = e.manipulator->getJointPosition();
+      if (q.size() == model.getNumberOfJoints()) {
+        forwardKinematics(model, *e.data, q);
+        for (std::size_t f = 0; f < e.frames.size(); ++f) {
+          const std::string& name = e.frames[f];
+          if (name == "base") {
+            poses[f] = model.getBaseTransform();
+          } else if (name == "endEffector") {
+            poses[f] = e.data->endEffector;
+          } else if (name.rfind("link", 0) == 0) {
+            int k = std::atoi(name.c_str() + 4);
+            if (k >= 1 && k <= model.getNumberOfJoints()) poses[f] = e.data->linkTransforms[static_cast<std::size_t>(k - 1)];
+          }
+        }
+      }
+    } else if (e.physical) {
+      // World pose through the chain of connections (bounded: a cycle cannot hang us).
+      Transform world = e.physical->getTransform();
+      PhysicalObject* child = e.physical;
+      for (int depth = 0; depth < 16; ++depth) {
+        PhysicalObject* mount = child->getConnection();
+        if (!mount) break;
+        Transform frame = mount->getTransform();
+        if (auto* m = dynamic_cast<Manipulator*>(mount)) {
+          const std::string f = child->getConnectionFrame();
+          frame = m->getModel().getBaseTransform();
+          if (f != "base") {
+            auto mi = entries_.find(mount);
+            if (mi != entries_.end() && mi->second.data) {
+              const ManipulatorModel& model = m->getModel();
+              JointVector q = m->getJointPosition();
+              if (q.size() == model.getNumberOfJoints()) {
+                forwardKinematics(model, *mi->second.data, q);
+                if (f == "endEffector") frame = mi->second.data->endEffector;
+                else if (f.rfind("link", 0) == 0) {
+                  int k = std::atoi(f.c_str() + 4);
+                  if (k >= 1 && k <= model.getNumberOfJoints()) frame = mi->second.data->linkTransforms[static_cast<std::size_t>(k - 1)];
+                }
+              }
+            }
+          }
+          world = frame * world;
+          break;  // a manipulator's frames are already in the world
+        }
+        world = frame * world;
+        child = mount;
+      }
+      for (auto& p : poses) p = world;
+    }
+    put32(out, static_cast<std::uint32_t>(e.index));
+    put32(out, static_cast<std::uint32_t>(poses.size()));
+    const int values = hasState ? std::clamp(snap.size, 0, kMaxStateValues) : 0;
+    put32(out, static_cast<std::uint32_t>(values));
+    put32(out, static_cast<std::uint32_t>(o.getErrorCode()));
+    for (const Transform& p : poses) putTransform(out, p);
+    for (int i = 0; i < values; ++i) putDouble(out, snap.values[i]);
+    ++count;
+  });
+  for (int i = 0; i < 4; ++i) out[countAt + static_cast<std::size_t>(i)] = static_cast<char>((count >> (8 * i)) & 0xffu);
+  std::string t;
+  putDouble(t, time);
+  out.replace(timeAt, 8, t);
+  return out;
+}
+
+}  // namespace rp::internal

@@ -1,0 +1,64 @@
+// The Scene Viewer's view of the objects: the scene description (JSON, replayed to every page)
+// and the binary state frames, built in the server thread from the ObjectManager's objects.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rp/core/PhysicalObject.hpp"
+#include "rp/core/RoboticObject.hpp"
+
+namespace rp {
+class Manipulator;
+struct ManipulatorData;
+}  // namespace rp
+
+namespace rp::internal {
+
+// Magic number at the start of every binary state frame: "RPS1" read as a little-endian u32.
+inline constexpr std::uint32_t kStateFrameMagic = 0x31535052u;
+
+class SceneState {
+ public:
+  SceneState();
+  ~SceneState();
+  SceneState(const SceneState&) = delete;
+  SceneState& operator=(const SceneState&) = delete;
+
+  // Looks at the object list; objects seen for the first time are only recorded (they may still
+  // be under construction), objects seen before are described. Returns true if the scene
+  // description changed (then scene() has a new version).
+  bool refresh();
+  // The scene message: {"type": "scene", "protocol", "version", "objects": [...]}.
+  const std::string& sceneMessage() const { return sceneMessage_; }
+  std::uint32_t version() const { return version_; }
+
+  // Builds one binary state frame of every described object that still exists.
+  std::string buildFrame();
+
+ private:
+  struct Entry {
+    RoboticObject* object = nullptr;
+    std::string name;
+    int sightings = 0;
+    bool described = false;
+    PhysicalObject* physical = nullptr;
+    Manipulator* manipulator = nullptr;
+    std::vector<std::string> frames;
+    std::unique_ptr<ManipulatorData> data;
+    int index = -1;  // position in the scene's object array
+  };
+  nlohmann::json describe(Entry& e);
+
+  std::map<RoboticObject*, Entry> entries_;
+  std::string sceneMessage_;
+  std::string lastObjects_;
+  std::uint32_t version_ = 0;
+};
+
+}  // namespace rp::internal

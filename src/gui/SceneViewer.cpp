@@ -1,0 +1,757 @@
+// The Scene Viewer server: HTTP + WebSocket (Boost.Beast) on its own thread, a worker thread for
+// commands that touch objects, state frames at display rate. See docs/gui.md for the protocol.
+#include "rp/gui/SceneViewer.hpp"
+
+#include <utility>  // before Boost 1.74's asio, which uses std::exchange without including it
+
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdlib>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <mutex>
+#include <random>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "SceneState.hpp"
+#include "rp/core/ObjectManager.hpp"
+#include "rp/core/PhysicalObject.hpp"
+#include "rp/core/RoboticPlatform.hpp"
+#include "rp/rt/ControlProgram.hpp"
+
+#ifndef RP_WEB_ROOT_BUILD
+#define RP_WEB_ROOT_BUILD ""
+#endif
+#ifndef RP_WEB_ROOT_INSTALL
+#define RP_WEB_ROOT_INSTALL ""
+#endif
+
+namespace rp {
+
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using nlohmann::json;
+
+constexpr std::size_t kMaxMessageBytes = 64 * 1024;  // largest WebSocket message accepted
+constexpr std::size_t kMaxTextQueue = 256;           // replies and scenes waiting for a slow page
+constexpr std::size_t kMaxWorkQueue = 128;           // commands waiting for the worker thread
+constexpr std::size_t kMaxStringField = 256;         // longest name, command or message type
+constexpr int kPortFallbacks = 20;
+
+std::string& startPageStorage() {
+  static std::string* page = new std::string("index.html");
+  return *page;
+}
+std::mutex& startPageMutex() {
+  static std::mutex* m = new std::mutex;
+  return *m;
+}
+
+std::string generateToken() {
+  std::random_device rd;
+  std::string t;
+  const char* hex = "0123456789abcdef";
+  for (int i = 0; i < 32; ++i) t += hex[rd() % 16];
+  return t;
+}
+
+bool constantTimeEqual(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  unsigned char d = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) d |= static_cast<unsigned char>(a[i] ^ b[i]);
+  return d == 0;
+}
+
+// Value of `key` in the query string of `target` (no percent-decoding: tokens are hex).
+std::string queryValue(std::string_view target, std::string_view key) {
+  auto q = target.find('?');
+  if (q == std::string_view::npos) return {};
+  std::string_view query = target.substr(q + 1);
+  while (!query.empty()) {
+    auto amp = query.find('&');
+    std::string_view pair = query.substr(0, amp);
+    auto eq = pair.find('=');
+    if (pair.substr(0, eq) == key) return std::string(eq == std::string_view::npos ? "" : pair.substr(eq + 1));
+    if (amp == std::string_view::npos) break;
+    query = query.substr(amp + 1);
+  }
+  return {};
+}
+
+std::string mimeType(const std::string& path) {
+  auto ext = std::filesystem::path(path).extension().string();
+  if (ext == ".html") return "text/html; charset=utf-8";
+  if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
+  if (ext == ".css") return "text/css; charset=utf-8";
+  if (ext == ".json") return "application/json";
+  if (ext == ".png") return "image/png";
+  if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".ico") return "image/x-icon";
+  if (ext == ".wasm") return "application/wasm";
+  return "application/octet-stream";
+}
+
+const char* kNotBuiltPage =
+    "<!doctype html><html><head><meta charset=\"utf-8\"><title>Robotic Platform</title></head><body>"
+    "<h1>Robotic Platform Scene Viewer</h1><p>The front end is not built. Build the CMake target "
+    "<code>rp_web</code> (it runs <code>npm ci</code> and <code>npm run build</code> in <code>web/</code>) "
+    "or point the environment variable <code>RP_WEB_ROOT</code> at a built front end.</p></body></html>";
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+struct SceneViewer::Impl {
+  class WsSession;
+  class HttpSession;
+
+  mutable std::mutex mutex;  // guards the fields below that other threads read
+  bool running = false;
+  SceneViewerOptions options;
+  std::string token;
+  int port = 0;
+  std::string url;
+
+  std::unique_ptr<asio::io_context> ioc;
+  std::unique_ptr<tcp::acceptor> acceptor;
+  std::unique_ptr<asio::steady_timer> timer;
+  std::thread thread;
+
+  // Server-thread state.
+  std::set<std::shared_ptr<WsSession>> sessions;
+  internal::SceneState scene;
+  std::chrono::steady_clock::time_point lastRefresh{};
+  std::chrono::steady_clock::duration period{};
+
+  // Worker thread for commands that touch objects (they may block, e.g. a serial device).
+  std::thread worker;
+  std::mutex workMutex;
+  std::condition_variable workCv;
+  std::deque<std::function<void()>> work;
+  bool workerStop = false;
+
+  // Statistics.
+  std::atomic<std::uint64_t> connections{0}, framesBuilt{0}, framesSent{0}, framesDropped{0}, messagesReceived{0},
+      messagesRefused{0}, handshakesRefused{0};
+  std::atomic<std::size_t> pageCount{0};
+
+  void accept();
+  void tick();
+  bool refreshScene(bool force);
+  void onMessage(const std::shared_ptr<WsSession>& session, std::string text, bool binary);
+  bool enqueueWork(std::function<void()> job);
+  void workerLoop();
+};
+
+// A page's WebSocket: a bounded queue of text messages and a one-slot queue of the latest state frame.
+class SceneViewer::Impl::WsSession : public std::enable_shared_from_this<SceneViewer::Impl::WsSession> {
+ public:
+  WsSession(Impl& impl, tcp::socket&& socket) : impl_(impl), ws_(std::move(socket)) {}
+
+  void run(http::request<http::string_body> req) {
+    ws_.read_message_max(kMaxMessageBytes);
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
+      if (ec) return self->close();
+      self->impl_.sessions.insert(self);
+      self->impl_.pageCount.store(self->impl_.sessions.size());
+      self->impl_.connections.fetch_add(1);
+      json hello = {{"type", "hello"},
+                    {"protocol", kSceneViewerProtocolVersion},
+                    {"qmotor", RoboticPlatform::isQMotorOn()},
+                    {"rate", self->impl_.options.rate}};
+      self->sendText(hello.dump());
+      if (!self->impl_.refreshScene(true)) self->sendText(self->impl_.scene.sceneMessage());
+      self->read();
+    });
+  }
+
+  void sendText(std::string text) {
+    if (closed_) return;
+    if (text_.size() >= kMaxTextQueue) {  // the page does not keep up: drop it, not the server
+      close();
+      return;
+    }
+    text_.push_back(std::make_shared<const std::string>(std::move(text)));
+    write();
+  }
+
+  void sendState(const std::shared_ptr<const std::string>& frame) {
+    if (closed_) return;
+    if (state_) impl_.framesDropped.fetch_add(1);
+    state_ = frame;
+    write();
+  }
+
+  void close() {
+    if (closed_) return;
+    closed_ = true;
+    impl_.sessions.erase(shared_from_this());
+    impl_.pageCount.store(impl_.sessions.size());
+    beast::error_code ec;
+    beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ec);
+    beast::get_lowest_layer(ws_).socket().close(ec);
+  }
+
+ private:
+  void read() {
+    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) {
+        if (ec == websocket::error::message_too_big) self->impl_.messagesRefused.fetch_add(1);
+        return self->close();
+      }
+      std::string text = beast::buffers_to_string(self->buffer_.data());
+      self->buffer_.consume(self->buffer_.size());
+      self->impl_.onMessage(self, std::move(text), !self->ws_.got_text());
+      self->read();
+    });
+  }
+
+  void write() {
+    if (writing_ || closed_) return;
+    std::shared_ptr<const std::string> next;
+    bool binary = false;
+    if (!text_.empty()) {
+      next = text_.front();
+      text_.pop_front();
+    } else if (state_) {
+      next = std::move(state_);
+      state_.reset();
+      binary = true;
+    } else {
+      return;
+    }
+    writing_ = true;
+    ws_.binary(binary);
+    ws_.async_write(asio::buffer(*next), [self = shared_from_this(), next, binary](beast::error_code ec, std::size_t) {
+      self->writing_ = false;
+      if (ec) return self->close();
+      if (binary) self->impl_.framesSent.fetch_add(1);
+      self->write();
+    });
+  }
+
+  Impl& impl_;
+  websocket::stream<beast::tcp_stream> ws_;
+  beast::flat_buffer buffer_;
+  std::deque<std::shared_ptr<const std::string>> text_;
+  std::shared_ptr<const std::string> state_;
+  bool writing_ = false;
+  bool closed_ = false;
+};
+
+// An HTTP connection: static files of the web root, or the upgrade to a page's WebSocket.
+class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<SceneViewer::Impl::HttpSession> {
+ public:
+  HttpSession(Impl& impl, tcp::socket&& socket) : impl_(impl), stream_(std::move(socket)) {}
+
+  void run() { read(); }
+
+ private:
+  void read() {
+    parser_.emplace();
+    parser_->header_limit(8 * 1024);
+    parser_->body_limit(8 * 1024);
+    stream_.expires_after(std::chrono::seconds(30));
+    http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) {
+        beast::error_code ignored;
+        self->stream_.socket().shutdown(tcp::socket::shutdown_both, ignored);
+        return;
+      }
+      self->handle(self->parser_->release());
+    });
+  }
+
+  void handle(http::request<http::string_body> req) {
+    const std::string target(req.target());
+    if (websocket::is_upgrade(req)) {
+      std::string why;
+      if (target.substr(0, target.find('?')) != "/ws") why = "no WebSocket at this path";
+      else if (!impl_.token.empty() && !constantTimeEqual(queryValue(target, "token"), impl_.token))
+        why = "wrong or missing token";
+      else if (auto origin = req.find(http::field::origin); origin != req.end()) {
+        const std::string host(req[http::field::host]);
+        const std::string o(origin->value());
+        if (o != "http://" + host && o != "https://" + host) why = "Origin " + o + " is not this server";
+      }
+      if (!why.empty()) {
+        impl_.handshakesRefused.fetch_add(1);
+        return respond(http::status::forbidden, "text/plain", "Scene Viewer: " + why + "\n", req);
+      }
+      stream_.expires_never();
+      std::make_shared<WsSession>(impl_, stream_.release_socket())->run(std::move(req));
+      return;
+    }
+    if (req.method() != http::verb::get && req.method() != http::verb::head)
+      return respond(http::status::method_not_allowed, "text/plain", "only GET\n", req);
+    std::string path = target.substr(0, target.find('?'));
+    if (path == "/") path = "/index.html";
+    if (path.empty() || path[0] != '/' || path.find("..") != std::string::npos || path.find('\\') != std::string::npos ||
+        path.find('%') != std::string::npos || path.find('\0') != std::string::npos)
+      return respond(http::status::bad_request, "text/plain", "bad path\n", req);
+    if (path == "/api/info") {
+      json info = {{"protocol", kSceneViewerProtocolVersion}, {"tokenRequired", !impl_.token.empty()}};
+      return respond(http::status::ok, "application/json", info.dump(), req);
+    }
+    const std::filesystem::path file = std::filesystem::path(impl_.options.webRoot) / path.substr(1);
+    std::ifstream in(file, std::ios::binary);
+    std::error_code ec;
+    if (!in || !std::filesystem::is_regular_file(file, ec)) {
+      if (path == "/index.html") return respond(http::status::ok, "text/html; charset=utf-8", kNotBuiltPage, req);
+      return respond(http::status::not_found, "text/plain", "not found: " + path + "\n", req);
+    }
+    std::ostringstream body;
+    body << in.rdbuf();
+    respond(http::status::ok, mimeType(path), body.str(), req);
+  }
+
+  void respond(http::status status, const std::string& type, std::string body,
+               const http::request<http::string_body>& req) {
+    auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
+    res->set(http::field::server, "Robotic Platform Scene Viewer");
+    res->set(http::field::content_type, type);
+    res->set(http::field::cache_control, "no-cache");
+    res->set("X-Content-Type-Options", "nosniff");
+    res->keep_alive(req.keep_alive());
+    if (req.method() != http::verb::head) res->body() = std::move(body);
+    res->prepare_payload();
+    http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
+      if (ec || !res->keep_alive()) {
+        beast::error_code ignored;
+        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+        return;
+      }
+      self->read();
+    });
+  }
+
+  Impl& impl_;
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+};
+
+void SceneViewer::Impl::accept() {
+  acceptor->async_accept([this](beast::error_code ec, tcp::socket socket) {
+    if (ec == asio::error::operation_aborted) return;
+    if (!ec) std::make_shared<HttpSession>(*this, std::move(socket))->run();
+    accept();
+  });
+}
+
+bool SceneViewer::Impl::refreshScene(bool force) {
+  auto now = std::chrono::steady_clock::now();
+  if (!force && now - lastRefresh < std::chrono::milliseconds(250)) return false;
+  lastRefresh = now;
+  // Objects seen the first time are only recorded; a second look describes them.
+  bool changed = scene.refresh();
+  if (force) changed = scene.refresh() || changed;
+  if (changed)
+    for (const auto& s : std::vector<std::shared_ptr<WsSession>>(sessions.begin(), sessions.end()))
+      s->sendText(scene.sceneMessage());
+  return changed;
+}
+
+void SceneViewer::Impl::tick() {
+  timer->expires_at(timer->expiry() + period);
+  timer->async_wait([this](beast::error_code ec) {
+    if (ec) return;
+    tick();
+  });
+  if (sessions.empty()) return;  // nothing to do without pages: no cost to the program
+  refreshScene(false);
+  auto frame = std::make_shared<const std::string>(scene.buildFrame());
+  framesBuilt.fetch_add(1);
+  for (const auto& s : std::vector<std::shared_ptr<WsSession>>(sessions.begin(), sessions.end())) s->sendState(frame);
+}
+
+bool SceneViewer::Impl::enqueueWork(std::function<void()> job) {
+  std::lock_guard<std::mutex> lock(workMutex);
+  if (work.size() >= kMaxWorkQueue) return false;
+  work.push_back(std::move(job));
+  workCv.notify_one();
+  return true;
+}
+
+void SceneViewer::Impl::workerLoop() {
+  for (;;) {
+    std::function<void()> job;
+    {
+      std::unique_lock<std::mutex> lock(workMutex);
+      workCv.wait(lock, [&] { return workerStop || !work.empty(); });
+      if (work.empty()) return;
+      job = std::move(work.front());
+      work.pop_front();
+    }
+    job();
+  }
+}
+
+void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std::string text, bool binary) {
+  messagesReceived.fetch_add(1);
+  json id = nullptr;
+  auto refuse = [&](const std::string& why) {
+    messagesRefused.fetch_add(1);
+    session->sendText(json{{"type", "error"}, {"id", id}, {"message", why}}.dump());
+  };
+  if (binary) return refuse("binary messages are not accepted (send JSON text)");
+  json msg = json::parse(text, nullptr, false);
+  if (msg.is_discarded()) return refuse("not valid JSON");
+  if (!msg.is_object()) return refuse("a message must be a JSON object");
+  if (msg.contains("id")) {
+    if (!msg["id"].is_number_integer()) return refuse("'id' must be an integer");
+    id = msg["id"];
+  }
+  auto str = [&](const char* key, std::string& out) -> bool {
+    auto it = msg.find(key);
+    if (it == msg.end() || !it->is_string()) {
+      refuse(std::string("'") + key + "' must be a string");
+      return false;
+    }
+    out = it->get<std::string>();
+    if (out.empty() || out.size() > kMaxStringField) {
+      refuse(std::string("'") + key + "' must have 1 to 256 characters");
+      return false;
+    }
+    return true;
+  };
+  std::string type;
+  if (!str("type", type)) return;
+
+  if (type == "hello") {
+    auto it = msg.find("protocol");
+    if (it == msg.end() || !it->is_number_integer()) return refuse("'protocol' must be an integer");
+    if (it->get<long long>() != kSceneViewerProtocolVersion)
+      return refuse("protocol " + it->dump() + " is not supported (server speaks " +
+                    std::to_string(kSceneViewerProtocolVersion) + ")");
+    return session->sendText(json{{"type", "result"}, {"id", id}, {"ok", true}}.dump());
+  }
+  if (type == "ping") return session->sendText(json{{"type", "pong"}, {"id", id}}.dump());
+  if (type == "scene") return session->sendText(scene.sceneMessage());
+
+  std::string object;
+  if (!str("object", object)) return;
+  std::function<std::string()> action;  // runs in the worker; returns the reply text; throws on failure
+  if (type == "command") {
+    std::string command;
+    if (!str("command", command)) return;
+    action = [object, command] {
+      RoboticObject* o = ObjectManager().findObject(object);
+      if (!o) throw std::invalid_argument("no object '" + object + "'");
+      o->executeCommand(command);
+      return std::string();
+    };
+  } else if (type == "display") {
+    std::string mode;
+    if (!str("mode", mode)) return;
+    if (mode != "off" && mode != "solid" && mode != "wireframe") return refuse("'mode' must be off, solid or wireframe");
+    action = [object, mode] {
+      auto* o = ObjectManager().findObject<PhysicalObject>(object);
+      if (!o) throw std::invalid_argument("no physical object '" + object + "'");
+      o->setDisplayMode(mode == "off" ? DisplayMode::Off : mode == "solid" ? DisplayMode::Solid : DisplayMode::Wireframe);
+      return std::string();
+    };
+  } else if (type == "setParameter") {
+    std::string name;
+    if (!str("name", name)) return;
+    std::vector<double> values;
+    long long index = -1;
+    if (auto v = msg.find("value"); v != msg.end()) {
+      if (!v->is_number()) return refuse("'value' must be a number");
+      values.push_back(v->get<double>());
+      if (auto i = msg.find("index"); i != msg.end()) {
+        if (!i->is_number_integer() || i->get<long long>() < 0 || i->get<long long>() > 1000000)
+          return refuse("'index' must be a non-negative integer");
+        index = i->get<long long>();
+      }
+    } else if (auto vs = msg.find("values"); vs != msg.end() && vs->is_array() && !vs->empty() && vs->size() <= 1024) {
+      for (const auto& x : *vs) {
+        if (!x.is_number()) return refuse("'values' must be numbers");
+        values.push_back(x.get<double>());
+      }
+    } else {
+      return refuse("setParameter needs 'value' (a number) or 'values' (1 to 1024 numbers)");
+    }
+    for (double v : values)
+      if (!std::isfinite(v)) return refuse("parameter values must be finite");
+    action = [object, name, values, index] {
+      RoboticObject* o = ObjectManager().findObject(object);
+      if (!o) throw std::invalid_argument("no object '" + object + "'");
+      ControlProgram* p = o->getControlProgram();
+      if (!p) throw std::invalid_argument("object '" + object + "' has no tunable parameters");
+      if (values.size() > 1) p->setParameter(name, values);
+      else if (index >= 0) p->setParameter(name, static_cast<std::size_t>(index), values[0]);
+      else p->setParameter(name, values[0]);
+      json now = p->getParameter(name);
+      return now.dump();
+    };
+  } else if (type == "message") {
+    std::string messageType;
+    if (!str("messageType", messageType)) return;
+    std::string payload;
+    if (auto p = msg.find("payload"); p != msg.end()) {
+      if (!p->is_string()) return refuse("'payload' must be a string");
+      payload = p->get<std::string>();
+    }
+    action = [object, messageType, payload] {
+      RoboticObject* o = ObjectManager().findObject(object);
+      if (!o) throw std::invalid_argument("no object '" + object + "'");
+      std::string reply;
+      if (!o->handleMessage(messageType, payload, reply))
+        throw std::invalid_argument("object '" + object + "' does not understand the message '" + messageType + "'");
+      return reply;
+    };
+  } else {
+    return refuse("unknown message type '" + type + "' (known: hello, ping, scene, command, display, setParameter, message)");
+  }
+
+  std::weak_ptr<WsSession> weak = session;
+  asio::io_context* io = ioc.get();
+  bool queued = enqueueWork([this, weak, io, id, action = std::move(action)] {
+    json reply;
+    try {
+      std::string r = action();
+      reply = {{"type", "result"}, {"id", id}, {"ok", true}, {"reply", r}};
+    } catch (const std::exception& e) {
+      messagesRefused.fetch_add(1);
+      reply = {{"type", "error"}, {"id", id}, {"message", e.what()}};
+    }
+    asio::post(*io, [this, weak, text = reply.dump()]() mutable {
+      if (auto s = weak.lock()) s->sendText(std::move(text));
+      refreshScene(true);  // display mode, parameters or errors may have changed: tell every page
+    });
+  });
+  if (!queued) refuse("the server is busy (too many commands waiting)");
+}
+
+// ---------------------------------------------------------------------------------------------
+SceneViewer::SceneViewer() : impl_(std::make_unique<Impl>()) {}
+
+SceneViewer::~SceneViewer() { stop(); }
+
+SceneViewer& SceneViewer::instance() {
+  static SceneViewer* viewer = new SceneViewer;  // never destroyed: stop() runs at exit
+  return *viewer;
+}
+
+bool SceneViewer::isLoopbackAddress(const std::string& address) {
+  beast::error_code ec;
+  auto a = asio::ip::make_address(address, ec);
+  return !ec && a.is_loopback();
+}
+
+std::string SceneViewer::defaultWebRoot() {
+  if (const char* env = std::getenv("RP_WEB_ROOT"); env && *env) return env;
+  std::error_code ec;
+  if (std::string(RP_WEB_ROOT_BUILD).size() && std::filesystem::exists(std::string(RP_WEB_ROOT_BUILD) + "/index.html", ec))
+    return RP_WEB_ROOT_BUILD;
+  if (std::string(RP_WEB_ROOT_INSTALL).size()) return RP_WEB_ROOT_INSTALL;
+  return RP_WEB_ROOT_BUILD;
+}
+
+void SceneViewer::start(const SceneViewerOptions& options) {
+  Impl& m = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(m.mutex);
+    if (m.running) throw std::logic_error("SceneViewer::start: already running");
+  }
+  if (!(options.rate >= 1 && options.rate <= 240))
+    throw std::invalid_argument("SceneViewer: rate must be 1..240 Hz, not " + std::to_string(options.rate));
+  if (options.port < 0 || options.port > 65535)
+    throw std::invalid_argument("SceneViewer: port must be 0..65535, not " + std::to_string(options.port));
+  beast::error_code ec;
+  auto address = asio::ip::make_address(options.address, ec);
+  if (ec) throw std::invalid_argument("SceneViewer: '" + options.address + "' is not an IP address");
+
+  m.options = options;
+  if (m.options.webRoot.empty()) m.options.webRoot = defaultWebRoot();
+  m.token = options.token;
+  if (m.token.empty() && !address.is_loopback()) m.token = generateToken();
+  m.ioc = std::make_unique<asio::io_context>(1);
+  m.acceptor = std::make_unique<tcp::acceptor>(*m.ioc);
+
+  auto tryListen = [&](int port) -> bool {
+    beast::error_code e;
+    tcp::endpoint ep(address, static_cast<unsigned short>(port));
+    m.acceptor->open(ep.protocol(), e);
+    if (e) return false;
+    m.acceptor->set_option(asio::socket_base::reuse_address(true), e);
+    m.acceptor->bind(ep, e);
+    if (!e) m.acceptor->listen(asio::socket_base::max_listen_connections, e);
+    if (e) {
+      beast::error_code ignored;
+      m.acceptor->close(ignored);
+      ec = e;
+      return false;
+    }
+    return true;
+  };
+  bool ok = tryListen(options.port);
+  if (!ok && options.port == kSceneViewerDefaultPort) {
+    for (int i = 1; i <= kPortFallbacks && !ok && options.port + i <= 65535; ++i) ok = tryListen(options.port + i);
+    if (!ok) ok = tryListen(0);
+  }
+  if (!ok) {
+    m.acceptor.reset();
+    m.ioc.reset();
+    throw std::runtime_error("SceneViewer: cannot listen on " + options.address + ":" + std::to_string(options.port) +
+                             ": " + ec.message());
+  }
+  const int port = m.acceptor->local_endpoint().port();
+  std::string host = options.address;
+  if (address.is_unspecified()) host = asio::ip::host_name();
+  else if (address.is_v6()) host = "[" + host + "]";
+  std::string page = m.options.startPage.empty() ? "index.html" : m.options.startPage;
+  std::string url = "http://" + host + ":" + std::to_string(port) + "/" + page;
+  if (!m.token.empty()) url += (page.find('?') == std::string::npos ? "?" : "&") + std::string("token=") + m.token;
+
+  m.period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(1.0 / options.rate));
+  m.timer = std::make_unique<asio::steady_timer>(*m.ioc);
+  m.timer->expires_after(m.period);
+  m.timer->async_wait([&m](beast::error_code e) {
+    if (!e) m.tick();
+  });
+  m.accept();
+  m.connections = 0;
+  m.framesBuilt = m.framesSent = m.framesDropped = m.messagesReceived = m.messagesRefused = m.handshakesRefused = 0;
+  m.workerStop = false;
+  m.worker = std::thread([&m] { m.workerLoop(); });
+  m.thread = std::thread([&m] { m.ioc->run(); });
+  std::lock_guard<std::mutex> lock(m.mutex);
+  m.port = port;
+  m.url = url;
+  m.running = true;
+}
+
+void SceneViewer::stop() {
+  Impl& m = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(m.mutex);
+    if (!m.running) return;
+    m.running = false;
+  }
+  {
+    std::lock_guard<std::mutex> lock(m.workMutex);
+    m.workerStop = true;
+    m.work.clear();
+    m.workCv.notify_all();
+  }
+  if (m.worker.joinable()) m.worker.join();
+  asio::post(*m.ioc, [&m] {
+    beast::error_code ec;
+    m.acceptor->close(ec);
+    m.timer->cancel();
+    for (const auto& s : std::vector<std::shared_ptr<Impl::WsSession>>(m.sessions.begin(), m.sessions.end())) s->close();
+  });
+  // Give open connections a moment to close, then stop whatever is left.
+  std::thread stopper([&m] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    m.ioc->stop();
+  });
+  if (m.thread.joinable()) m.thread.join();
+  stopper.join();
+  m.sessions.clear();
+  m.timer.reset();
+  m.acceptor.reset();
+  m.ioc.reset();
+  m.pageCount = 0;
+  std::lock_guard<std::mutex> lock(m.mutex);
+  m.port = 0;
+  m.url.clear();
+}
+
+bool SceneViewer::isRunning() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->running;
+}
+
+std::string SceneViewer::getUrl() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->url;
+}
+
+int SceneViewer::getPort() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->port;
+}
+
+std::string SceneViewer::getToken() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->running ? impl_->token : std::string();
+}
+
+std::string SceneViewer::getWebRoot() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->running ? impl_->options.webRoot : defaultWebRoot();
+}
+
+SceneViewerStatistics SceneViewer::getStatistics() const {
+  const Impl& m = *impl_;
+  SceneViewerStatistics s;
+  s.pages = m.pageCount.load();
+  s.connections = m.connections.load();
+  s.framesBuilt = m.framesBuilt.load();
+  s.framesSent = m.framesSent.load();
+  s.framesDropped = m.framesDropped.load();
+  s.messagesReceived = m.messagesReceived.load();
+  s.messagesRefused = m.messagesRefused.load();
+  s.handshakesRefused = m.handshakesRefused.load();
+  return s;
+}
+
+void SceneViewer::setStartPage(const std::string& page) {
+  std::lock_guard<std::mutex> lock(startPageMutex());
+  startPageStorage() = page;
+}
+
+void SceneViewer::startFromPlatform() {
+  SceneViewerOptions o;
+  o.address = RoboticPlatform::getGuiAddress();
+  const int port = RoboticPlatform::getGuiPort();
+  o.port = port < 0 ? kSceneViewerDefaultPort : port;
+  o.token = RoboticPlatform::getGuiToken();
+  {
+    std::lock_guard<std::mutex> lock(startPageMutex());
+    o.startPage = startPageStorage();
+  }
+  try {
+    instance().start(o);
+  } catch (const std::exception& e) {
+    std::cerr << "rp: " << e.what() << "\n";
+    if (port > 0 || dynamic_cast<const std::invalid_argument*>(&e)) std::exit(2);  // the user asked for exactly this
+    std::cerr << "rp: running without the Scene Viewer\n";
+    return;
+  }
+  static std::once_flag atExit;
+  std::call_once(atExit, [] { std::atexit([] { instance().stop(); }); });
+  std::cerr << "rp: Scene Viewer at " << instance().getUrl() << std::endl;
+}
+
+namespace {
+// The library registers the viewer as the platform's GUI when it is loaded.
+[[maybe_unused]] const bool kGuiRegistered = [] {
+  RoboticPlatform::setGuiStarter([] { SceneViewer::startFromPlatform(); });
+  return true;
+}();
+}  // namespace
+
+}  // namespace rp

@@ -1,0 +1,74 @@
+// Browser test of rp-jointmove (Figure 19): a slider moves the simulated joint through the servo
+// loop; gains tuned in the viewer's control panel reach the servo loop (with the gains of a joint
+// at zero its servo torque at rest becomes zero).
+import { describe, it } from 'node:test';
+import assert from 'node:assert/strict';
+import { join } from 'node:path';
+import { withProgram, openViewer, waitInPage, sleep } from './harness.mjs';
+
+const shots = process.env.RP_SCREENSHOT_DIR;
+const DEG = Math.PI / 180;
+
+describe('rp-jointmove', () => {
+  const ctx = withProgram('rp-jointmove', ['-gui-port', '0']);
+
+  const jointAngle = (i) => ctx.page.evaluate((j) => window.rp.frame.objects.find((o) => window.rp.scene.objects[o.index].name === 'puma').values[j], i);
+  const slide = (i, degrees) => ctx.page.evaluate(([j, d]) => {
+    const s = document.querySelector(`input[data-joint="${j}"]`);
+    s.value = String(d);
+    s.dispatchEvent(new Event('input'));
+  }, [i, degrees]);
+
+  it('opens the Joint Move page with a slider per joint of the Puma', async () => {
+    assert.match(ctx.url, /\/jointmove\.html$/);
+    assert.match(ctx.program.output(), /rp-jointmove: moving puma \(Puma560, 6 joints\)/);
+    await ctx.page.waitForSelector('input[data-joint="5"]');
+    assert.equal(await ctx.page.locator('input[type="range"]').count(), 6);
+  });
+
+  it('a slider moves the simulated joint, and the arm follows at once', async () => {
+    const start = await jointAngle(0);
+    await slide(0, 40);
+    await sleep(300);
+    const early = await jointAngle(0);
+    assert.ok(Math.abs(early - start) > 0.5 * DEG, `joint 1 has not started moving after 0.3 s (${start} -> ${early})`);
+    await waitInPage(ctx.page, (target) => {
+      const o = window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'puma');
+      return Math.abs(o.values[0] - target) < 0.005 && Math.abs(o.values[6]) < 0.01;
+    }, 40 * DEG, 15000);
+    if (shots) await ctx.page.screenshot({ path: join(shots, 'joint-move.png') });
+  });
+
+  it('refuses a target outside the joint limits', async () => {
+    const err = await ctx.page.evaluate(() => window.rp.conn.message('jointmove', 'setJoint', JSON.stringify({ joint: 0, value: 100 }))
+      .then(() => 'accepted', (e) => e.message));
+    assert.match(err, /outside/);
+  });
+
+  it('gains set to zero in the control panel reach the servo loop: joint 1\'s torque drops to zero', async () => {
+    // At rest (setpoint velocity exactly 0) joint 1's servo torque is kp e - kd qd + ki integral
+    // (the friction feed-forward and the gravity torque of the vertical axis are 0).
+    const tau0 = () => ctx.page.evaluate(() => window.rp.frame.objects.find((o) => window.rp.scene.objects[o.index].name === 'puma').values[12]);
+    const before = await tau0();
+    assert.ok(Math.abs(before) > 1e-6, `joint 1's torque at rest is already ${before} N m`);
+    const viewer = await openViewer(ctx.browser, ctx.url.replace('jointmove.html', 'index.html'));
+    await viewer.evaluate(() => window.rp.openPanel('puma'));
+    const panel = viewer.locator('.panel[data-panel="puma"]');
+    for (const gain of ['kp', 'kd', 'ki']) {
+      const input = panel.locator(`input[data-field="${gain}"][data-index="0"]`);
+      await input.fill('0');
+      await input.dispatchEvent('change');
+    }
+    await waitInPage(viewer, () => ['kp', 'kd', 'ki'].every((g) => window.rp.scene.objects.find((o) => o.name === 'puma')
+      .panel.fields.find((f) => f.name === g).value[0] === 0));
+    try {
+      await waitInPage(ctx.page, () => Math.abs(window.rp.frame.objects.find((o) => window.rp.scene.objects[o.index].name === 'puma').values[12]) < 1e-9);
+    } catch (e) {
+      const v = await ctx.page.evaluate(() => window.rp.frame.objects.find((o) => window.rp.scene.objects[o.index].name === 'puma').values);
+      throw new Error(`joint 1's torque did not drop to 0: state ${JSON.stringify(v)}`);
+    }
+    const after = await tau0();
+    console.log(`joint 1 torque at rest: ${before} N m with the default gains, ${after} N m with kp = kd = ki = 0`);
+    await viewer.close();
+  });
+});

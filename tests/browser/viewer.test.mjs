@@ -1,0 +1,179 @@
+// Browser test of the Scene Viewer against the work_cell example (a Puma 560 with a gripper):
+// scene drawn and moving, object list, pop-up menu commands reaching the program, control panel
+// and tuning, two pages, reload, malformed messages, wrong token and foreign Origin refused.
+import { describe, it } from 'node:test';
+import assert from 'node:assert/strict';
+import { join } from 'node:path';
+import {
+  withProgram, openViewer, waitInPage, canvasStats, pixelsChanged, upgradeStatus, sleep,
+} from './harness.mjs';
+
+const TOKEN = 'browser-test-token-1234';
+const shots = process.env.RP_SCREENSHOT_DIR;
+
+describe('Scene Viewer on work_cell', () => {
+  const ctx = withProgram('work_cell', ['-gui-port', '0', '-gui-token', TOKEN, '--arm-only']);
+
+  it('prints a URL with the token, on loopback', () => {
+    assert.match(ctx.url, /^http:\/\/127\.0\.0\.1:\d+\/index\.html\?token=browser-test-token-1234$/);
+  });
+
+  it('draws the scene, and the picture changes as the arm moves', async () => {
+    await sleep(500);
+    const a = await canvasStats(ctx.page);
+    assert.ok(a.foreground > a.total * 0.02, `only ${a.foreground} of ${a.total} pixels differ from the background`);
+    const q0 = await ctx.page.evaluate(() => window.rp.frame.objects[0].values.slice(0, 6));
+    await sleep(1500);
+    const b = await canvasStats(ctx.page);
+    const q1 = await ctx.page.evaluate(() => window.rp.frame.objects[0].values.slice(0, 6));
+    const moved = q0.some((q, i) => Math.abs(q - q1[i]) > 1e-3);
+    assert.ok(moved, `the arm did not move: ${q0} -> ${q1}`);
+    assert.ok(pixelsChanged(a, b) > 50, `the picture did not change (${pixelsChanged(a, b)} pixels)`);
+    if (shots) await ctx.page.screenshot({ path: join(shots, 'scene-viewer.png') });
+  });
+
+  it('lists the program\'s objects with name and class', async () => {
+    const line = ctx.program.output().match(/work_cell: objects: (.*)/);
+    assert.ok(line, ctx.program.output());
+    const expected = [...line[1].matchAll(/(\S+) \(([^)]*)\)/g)].map((m) => [m[1], m[2]]);
+    assert.ok(expected.length >= 4);
+    const rows = await ctx.page.$$eval('#object-table tbody tr', (trs) =>
+      trs.map((tr) => [...tr.querySelectorAll('td')].map((td) => td.textContent)));
+    assert.deepEqual(rows, expected);
+  });
+
+  it('right-click on the gripper in the list, Close: the program\'s gripper closes', async () => {
+    const read = () => ctx.page.evaluate(async () => JSON.parse((await window.rp.conn.message('gripper', 'read', '')).reply));
+    assert.notEqual((await read()).state, 'closed');
+    await ctx.page.click('#object-table tr[data-object="gripper"]', { button: 'right' });
+    await ctx.page.waitForSelector('#popup-menu:not(.hidden)');
+    const items = await ctx.page.$$eval('#popup-menu .item', (els) => els.map((e) => e.textContent));
+    assert.deepEqual(items, ['Hide', 'Solid', 'Wireframe', 'Open', 'Close', 'Relax', 'Control Panel...']);
+    if (shots) await ctx.page.screenshot({ path: join(shots, 'popup-menu.png') });
+    await ctx.page.click('#popup-menu .item[data-action="Close"]');
+    await waitInPage(ctx.page, () => {
+      const f = window.rp.frame;
+      const i = window.rp.scene.objects.findIndex((o) => o.name === 'gripper');
+      const o = f.objects.find((x) => x.index === i);
+      return o && o.values[0] === 2; // Gripper::State::Closed, published by the program
+    });
+    assert.equal((await read()).state, 'closed');
+  });
+
+  it('right-click in the 3D view on the work piece, Wireframe then Hide: the program\'s display mode follows', async () => {
+    // Hide the arm first (from the list), so that nothing stands between the camera and the piece.
+    await ctx.page.click('#object-table tr[data-object="puma"]', { button: 'right' });
+    await ctx.page.click('#popup-menu .item[data-action="Hide"]');
+    await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'puma').display === 'off');
+    await sleep(100);
+    const pos = await ctx.page.evaluate(() => window.rp.view.screenPosition('workpiece'));
+    await ctx.page.mouse.click(pos.x, pos.y, { button: 'right' });
+    await ctx.page.waitForSelector('#popup-menu:not(.hidden)');
+    assert.match(await ctx.page.textContent('#popup-menu .title'), /^workpiece \(PhysicalObject\)$/);
+    await ctx.page.click('#popup-menu .item[data-action="Wireframe"]');
+    await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'workpiece').display === 'wireframe');
+    await ctx.page.mouse.click(pos.x, pos.y, { button: 'right' });
+    await ctx.page.click('#popup-menu .item[data-action="Hide"]');
+    await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'workpiece').display === 'off');
+    await ctx.page.click('#object-table tr[data-object="workpiece"]', { button: 'right' });
+    await ctx.page.click('#popup-menu .item[data-action="Show"]');
+    await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'workpiece').display === 'solid');
+    await ctx.page.click('#object-table tr[data-object="puma"]', { button: 'right' });
+    await ctx.page.click('#popup-menu .item[data-action="Show"]');
+    await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'puma').display === 'solid');
+  });
+
+  it('control panel of the Puma: live joint state, and a tuned gain reaches the servo loop', async () => {
+    await ctx.page.click('#object-table tr[data-object="puma"]', { button: 'right' });
+    await ctx.page.click('#popup-menu .item[data-action="Control Panel..."]');
+    const panel = ctx.page.locator('.panel[data-panel="puma"]');
+    await panel.waitFor();
+    const q = async () => panel.locator('.value[data-field="q"]').allTextContents();
+    const a = await q();
+    await sleep(500);
+    const b = await q();
+    assert.equal(a.length, 6);
+    assert.notDeepEqual(a, b, 'joint positions do not change');
+    assert.equal(await panel.locator('.value[data-field="power"]').textContent(), 'on');
+    if (shots) await ctx.page.screenshot({ path: join(shots, 'control-panel.png') });
+    // kp of joint 3 (the elbow, which carries the forearm's weight)
+    const kp = panel.locator('input[data-field="kp"][data-index="2"]');
+    await kp.fill('1234.5');
+    await kp.dispatchEvent('change');
+    await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'puma').panel.fields
+      .find((f) => f.name === 'kp').value[2] === 1234.5);
+    // Out of range: refused with a message, the value shown again.
+    await kp.fill('-1');
+    await kp.dispatchEvent('change');
+    await ctx.page.waitForSelector('#messages:not(.hidden)');
+    assert.match(await ctx.page.textContent('#messages'), /kp/);
+  });
+
+  it('two pages at once both receive state', async () => {
+    const second = await openViewer(ctx.browser, ctx.url, { width: 600, height: 400 });
+    const n1 = await ctx.page.evaluate(() => window.rp.frames);
+    const m1 = await second.evaluate(() => window.rp.frames);
+    await sleep(1000);
+    const n2 = await ctx.page.evaluate(() => window.rp.frames);
+    const m2 = await second.evaluate(() => window.rp.frames);
+    assert.ok(n2 - n1 > 20, `first page got ${n2 - n1} frames in 1 s`);
+    assert.ok(m2 - m1 > 20, `second page got ${m2 - m1} frames in 1 s`);
+    await second.close();
+  });
+
+  it('reconnects after a reload', async () => {
+    await ctx.page.reload();
+    await ctx.page.waitForFunction(() => window.rp && window.rp.scene && window.rp.frames > 5, null, { timeout: 15000 });
+    const names = await ctx.page.$$eval('#object-table tbody tr', (trs) => trs.map((tr) => tr.dataset.object));
+    assert.ok(names.includes('puma') && names.includes('gripper'));
+  });
+
+  it('refuses malformed messages with an error reply, and stays up', async () => {
+    const replies = await ctx.page.evaluate(async (token) => {
+      const ws = new WebSocket(`ws://${location.host}/ws?token=${token}`);
+      const got = [];
+      ws.onmessage = (e) => { if (typeof e.data === 'string') { const m = JSON.parse(e.data); if (m.type === 'error') got.push(m.message); } };
+      await new Promise((r) => (ws.onopen = r));
+      for (const m of ['not json', '[1,2]', '{"type":5}', '{"type":"command","object":"gripper"}',
+        '{"type":"launchMissiles","object":"puma"}', '{"type":"setParameter","object":"puma","name":"kp","value":"x"}',
+        '{"type":"command","object":"nobody","command":"Close"}', '{"type":"hello","protocol":99}'])
+        ws.send(m);
+      ws.send(new Uint8Array([1, 2, 3]));
+      await new Promise((r) => setTimeout(r, 1000));
+      const closed = new Promise((r) => (ws.onclose = r));
+      ws.send('x'.repeat(100 * 1024)); // larger than the server accepts: the connection is closed
+      await Promise.race([closed, new Promise((r) => setTimeout(r, 3000))]);
+      return { got, state: ws.readyState };
+    }, TOKEN);
+    assert.equal(replies.got.length, 9, JSON.stringify(replies.got));
+    const has = (re) => assert.ok(replies.got.some((m) => re.test(m)), `no error matching ${re}: ${replies.got}`);
+    has(/not valid JSON/);
+    has(/must be a JSON object/);
+    has(/'type' must be a string/);
+    has(/'command' must be a string/);
+    has(/unknown message type 'launchMissiles'/);
+    has(/'value' must be a number/);
+    has(/no object 'nobody'/);
+    has(/protocol 99 is not supported/);
+    has(/binary messages are not accepted/);
+    assert.equal(replies.state, 3, 'an oversize message must close the connection');
+    const n1 = await ctx.page.evaluate(() => window.rp.frames);
+    await sleep(500);
+    assert.ok((await ctx.page.evaluate(() => window.rp.frames)) > n1, 'the server stopped sending after bad messages');
+  });
+
+  it('refuses a wrong or missing token and a foreign Origin', async () => {
+    assert.equal(await upgradeStatus(ctx.url, { token: 'wrong' }), 403);
+    assert.equal(await upgradeStatus(ctx.url, {}), 403);
+    const u = new URL(ctx.url);
+    assert.equal(await upgradeStatus(ctx.url, { token: TOKEN, origin: 'http://evil.example' }), 403);
+    assert.equal(await upgradeStatus(ctx.url, { token: TOKEN, origin: `http://${u.host}` }), 101);
+    const opened = await ctx.page.evaluate(() => new Promise((resolve) => {
+      const ws = new WebSocket(`ws://${location.host}/ws?token=wrong`);
+      ws.onopen = () => resolve(true);
+      ws.onerror = () => resolve(false);
+    }));
+    assert.equal(opened, false);
+    assert.deepEqual(ctx.page.rpErrors, []);
+  });
+});

@@ -1,0 +1,68 @@
+// The Scene Viewer page: 3D view, Object List, pop-up menus and control panels.
+import './style.css';
+import { Connection } from './connection.js';
+import { notify, showStatus } from './ui.js';
+import { SceneView } from './scene.js';
+import { ObjectList, PopupMenu, ControlPanel } from './panels.js';
+
+const view = new SceneView(document.getElementById('view'));
+const panels = new Map();
+let scene = null;
+let lastFrame = null;
+
+function openPanel(name) {
+  if (panels.has(name)) return;
+  const p = new ControlPanel(conn, name, notify, (panel) => { panel.close(); panels.delete(name); });
+  panels.set(name, p);
+  const desc = scene && scene.objects.find((o) => o.name === name);
+  if (desc) p.setDesc(desc);
+}
+
+const conn = new Connection({
+  onStatus: showStatus,
+  onScene: (s) => {
+    scene = s;
+    view.setScene(s);
+    list.setScene(s);
+    for (const [name, p] of panels) {
+      const desc = s.objects.find((o) => o.name === name);
+      if (desc) p.setDesc(desc);
+    }
+  },
+  onFrame: (f) => {
+    lastFrame = f;
+    view.setFrame(f, scene);
+    for (const o of f.objects) {
+      const desc = scene && scene.objects[o.index];
+      const p = desc && panels.get(desc.name);
+      if (p) p.setValues(o.values);
+    }
+  },
+  onError: notify,
+});
+const menu = new PopupMenu(conn, openPanel, notify);
+const showMenu = (name, x, y) => {
+  const desc = scene && scene.objects.find((o) => o.name === name);
+  if (desc) menu.show(desc, x, y);
+};
+const list = new ObjectList(document.getElementById('object-list'), showMenu);
+
+view.renderer.domElement.addEventListener('contextmenu', (ev) => {
+  ev.preventDefault();
+  const name = view.pick(ev.clientX, ev.clientY);
+  if (name) showMenu(name, ev.clientX, ev.clientY);
+});
+document.getElementById('new-view').href = location.href;
+document.getElementById('toggle-list').addEventListener('click', () =>
+  document.getElementById('list-window').classList.toggle('hidden'));
+
+// For tests and the console: the live state of this page.
+window.rp = {
+  conn,
+  view,
+  get scene() { return scene; },
+  get frame() { return lastFrame; },
+  get frames() { return conn.frames; },
+  openPanel,
+  showMenu,
+};

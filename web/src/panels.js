@@ -1,0 +1,141 @@
+// Object List window, the object pop-up menu (Figure 17) and control panels (Figure 18),
+// rendered from the scene description and the state frames.
+
+function el(tag, attrs = {}, ...children) {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (k === 'class') e.className = v;
+    else if (k.startsWith('on')) e.addEventListener(k.slice(2), v);
+    else e.setAttribute(k, v);
+  }
+  for (const c of children) e.append(c);
+  return e;
+}
+
+function fmt(x) {
+  if (typeof x !== 'number' || !isFinite(x)) return String(x);
+  return Math.abs(x) >= 1000 || (Math.abs(x) < 1e-3 && x !== 0) ? x.toExponential(3) : x.toFixed(4);
+}
+
+export class ObjectList {
+  constructor(container, onMenu) {
+    this.container = container;
+    this.onMenu = onMenu;
+  }
+  setScene(scene) {
+    const rows = scene.objects.map((o) =>
+      el('tr', { 'data-object': o.name, oncontextmenu: (ev) => { ev.preventDefault(); this.onMenu(o.name, ev.clientX, ev.clientY); } },
+        el('td', {}, o.name), el('td', {}, o.className)));
+    const table = el('table', { id: 'object-table' },
+      el('thead', {}, el('tr', {}, el('th', {}, 'Name'), el('th', {}, 'Class'))), el('tbody', {}, ...rows));
+    this.container.replaceChildren(table);
+  }
+}
+
+export class PopupMenu {
+  constructor(conn, openPanel, notify) {
+    this.conn = conn;
+    this.openPanel = openPanel;
+    this.notify = notify;
+    this.menu = el('div', { id: 'popup-menu', class: 'popup hidden' });
+    document.body.append(this.menu);
+    document.addEventListener('click', () => this.hide());
+    document.addEventListener('keydown', (e) => e.key === 'Escape' && this.hide());
+  }
+  hide() {
+    this.menu.classList.add('hidden');
+  }
+  show(desc, x, y) {
+    const item = (label, action) =>
+      el('div', { class: 'item', 'data-action': label, onclick: (ev) => { ev.stopPropagation(); this.hide(); action(); } }, label);
+    const run = (p) => p.then(() => {}).catch((e) => this.notify(`${desc.name}: ${e.message}`));
+    const items = [el('div', { class: 'title' }, `${desc.name} (${desc.className})`)];
+    if (desc.physical) {
+      items.push(item(desc.display === 'off' ? 'Show' : 'Hide', () => run(this.conn.display(desc.name, desc.display === 'off' ? 'solid' : 'off'))));
+      items.push(item('Solid', () => run(this.conn.display(desc.name, 'solid'))));
+      items.push(item('Wireframe', () => run(this.conn.display(desc.name, 'wireframe'))));
+    }
+    if (desc.commands.length) items.push(el('div', { class: 'sep' }));
+    for (const c of desc.commands) {
+      const i = item(c.name, () => run(this.conn.command(desc.name, c.name)));
+      i.title = c.description;
+      items.push(i);
+    }
+    items.push(el('div', { class: 'sep' }));
+    items.push(item('Control Panel...', () => this.openPanel(desc.name)));
+    this.menu.replaceChildren(...items);
+    this.menu.style.left = `${x}px`;
+    this.menu.style.top = `${y}px`;
+    this.menu.classList.remove('hidden');
+  }
+}
+
+// A control panel window for one object.
+export class ControlPanel {
+  constructor(conn, name, notify, onClose) {
+    this.conn = conn;
+    this.name = name;
+    this.notify = notify;
+    this.body = el('div', { class: 'panel-body' });
+    this.status = el('div', { class: 'panel-status' });
+    this.title = el('span', {}, name);
+    this.win = el('div', { class: 'window panel', 'data-panel': name },
+      el('div', { class: 'window-title' }, this.title, el('button', { class: 'close', onclick: () => onClose(this) }, '×')),
+      this.status, this.body);
+    document.getElementById('panels').append(this.win);
+    this.cells = [];
+  }
+  close() {
+    this.win.remove();
+  }
+  setDesc(desc) {
+    const key = JSON.stringify(desc.panel);
+    this.desc = desc;
+    this.title.textContent = desc.panel.title;
+    this.status.textContent = desc.error.code ? `Error ${desc.error.code}: ${desc.error.message}` : 'No error';
+    this.status.className = `panel-status ${desc.error.code ? 'error' : ''}`;
+    if (key === this.key) return;
+    this.key = key;
+    this.cells = [];
+    const rows = [];
+    for (const f of desc.panel.fields) {
+      if (f.name === 'errorCode') continue;
+      const n = f.kind === 'vector' ? f.size : 1;
+      const cell = el('div', { class: 'values' });
+      if (f.tunable) {
+        for (let i = 0; i < n; ++i) {
+          const input = el('input', { type: 'number', step: 'any', 'data-field': f.name, 'data-index': String(i) });
+          if (f.value) input.value = f.value[i];
+          if (f.max > f.min) {
+            input.min = f.min;
+            input.max = f.max;
+          }
+          input.addEventListener('change', () => {
+            const v = Number(input.value);
+            this.conn.setParameter(this.name, f.name, v, f.kind === 'vector' ? i : undefined)
+              .catch((e) => { this.notify(`${this.name}.${f.name}: ${e.message}`); if (f.value) input.value = f.value[i]; });
+          });
+          cell.append(input);
+        }
+      } else if (f.stateIndex >= 0) {
+        for (let i = 0; i < n; ++i) {
+          const span = el('span', { class: 'value', 'data-field': f.name, 'data-index': String(i) }, '-');
+          cell.append(span);
+          this.cells.push({ span, index: f.stateIndex + i, field: f });
+        }
+      }
+      rows.push(el('div', { class: 'row' }, el('label', {}, `${f.label}${f.unit ? ` [${f.unit}]` : ''}${f.tunable ? ' (tunable)' : ''}`), cell));
+    }
+    this.body.replaceChildren(...rows);
+  }
+  setValues(values) {
+    for (const c of this.cells) {
+      const v = values[c.index];
+      if (v === undefined) continue;
+      let text = fmt(v);
+      if (c.field.kind === 'boolean') text = v ? 'on' : 'off';
+      else if (c.field.kind === 'choice') text = c.field.choices[v] ?? String(v);
+      c.span.textContent = text;
+    }
+  }
+}
