@@ -139,6 +139,17 @@ void ForwardDynamics_rp(benchmark::State& s) {
     benchmark::DoNotOptimize(forwardDynamics(*r.model, *r.data, r.q[i], r.qd[i], r.qdd[i]).data());
   }
 }
+// The mass-matrix route (Newton-Euler bias, Jacobian-based M, LDL^T), forwardDynamics() before
+// the articulated-body algorithm.
+void ForwardDynamicsArticulatedBody_rp(benchmark::State& s) {
+  Robot& r = robot(s);
+  std::size_t k = 0;
+  for (auto _ : s) {
+    const std::size_t i = k++ & 63;
+    benchmark::DoNotOptimize(forwardDynamicsArticulatedBody(*r.model, *r.data, r.q[i], r.qd[i], r.qdd[i]).data());
+  }
+}
+BENCHMARK(ForwardDynamicsArticulatedBody_rp)->Arg(6)->Arg(7);
 void ForwardDynamics_KDL(benchmark::State& s) {
   Robot& r = robot(s);
   KDL::ChainFdSolver_RNE fd(r.chain, KDL::Vector(0, 0, -9.81));

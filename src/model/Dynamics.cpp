@@ -20,6 +20,15 @@ namespace {
 
 using V3 = Eigen::Vector3d;
 
+// Joint-side friction B G^2 qd + |G| Tc(sign qd) (zero Coulomb part at rest).
+double jointFriction(const LinkParameters& l, double qd) {
+  const double g = std::abs(l.gearRatio);
+  double coulomb = 0;
+  if (qd > 0) coulomb = l.coulombFrictionPositive;
+  else if (qd < 0) coulomb = l.coulombFrictionNegative;
+  return g * (l.viscousFriction * g * qd + coulomb);
+}
+
 // The recursion itself, writing into `tau`. qd or qdd may be data.zero.
 void rnea(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q, const JointVector& qd,
           const JointVector& qdd, bool gravity, bool motorInertia, bool friction, const Vector<6>* tipWrench,
@@ -95,13 +104,7 @@ void rnea(const ManipulatorModel& model, ManipulatorData& data, const JointVecto
       t = nn(2);
     }
     if (motorInertia) t += model.getArmatureInertia()(i) * qdd(i);
-    if (friction) {
-      const double g = std::abs(l.gearRatio);
-      double coulomb = 0;
-      if (qd(i) > 0) coulomb = l.coulombFrictionPositive;
-      else if (qd(i) < 0) coulomb = l.coulombFrictionNegative;
-      t += g * (l.viscousFriction * g * qd(i) + coulomb);
-    }
+    if (friction) t += jointFriction(l, qd(i));
     tau(i) = t;
   }
 }
@@ -120,12 +123,7 @@ void gravityTorque(const ManipulatorModel& model, ManipulatorData& data, const J
 
 void frictionTorque(const ManipulatorModel& model, const JointVector& qd, JointVector& tau) {
   for (int i = 0; i < model.getNumberOfJoints(); ++i) {
-    const LinkParameters& l = model.getLink(i);
-    const double g = std::abs(l.gearRatio);
-    double coulomb = 0;
-    if (qd(i) > 0) coulomb = l.coulombFrictionPositive;
-    else if (qd(i) < 0) coulomb = l.coulombFrictionNegative;
-    tau(i) = g * (l.viscousFriction * g * qd(i) + coulomb);
+    tau(i) = jointFriction(model.getLink(i), qd(i));
   }
 }
 
@@ -134,46 +132,72 @@ void coriolisTorque(const ManipulatorModel& model, ManipulatorData& data, const 
   rnea(model, data, q, qd, data.zero, false, false, false, nullptr, tau);
 }
 
+namespace {
+
+using V6 = Eigen::Matrix<double, 6, 1>;
+using M6 = Eigen::Matrix<double, 6, 6>;
+
+Eigen::Matrix3d skew(const V3& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v(2), v(1), v(2), 0, -v(0), -v(1), v(0), 0;
+  return m;
+}
+
+// After forwardKinematics(): each joint's motion subspace S_i and each link's rigid spatial
+// inertia, as spatial vectors (angular; linear) in world coordinates at the world origin.
+// S_i = (z; o x z) for a rotation about the line through o along z, (0; z) for a translation.
+// The inertia is [Ic + m (|c|^2 1 - c c^T), h^; h^T, m 1] with c the centre of mass, h = m c and
+// Ic the inertia about c.
+void worldSubspacesAndInertias(const ManipulatorModel& model, ManipulatorData& data) {
+  for (int i = 0; i < data.n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const LinkParameters& l = model.getLink(i);
+    const Transform& axis = internal::axisFrame(model, data, i);
+    const V3 z = axis.block<3, 1>(0, 2);
+    V6& S = data.motionSubspace[k];
+    if (l.type == JointType::Prismatic) {
+      S << 0, 0, 0, z;
+    } else {
+      S << z, V3(axis.topRightCorner<3, 1>()).cross(z);
+    }
+    const Transform& T = data.linkTransforms[k];
+    const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+    const V3 c = R * V3(l.com) + V3(T.topRightCorner<3, 1>());
+    const Eigen::Matrix3d hx = skew(l.mass * c);
+    M6& I = data.articulatedInertia[k];
+    I.topLeftCorner<3, 3>().noalias() = R * Eigen::Matrix3d(l.inertia) * R.transpose();
+    I.topLeftCorner<3, 3>().noalias() -= hx * skew(c);
+    I.topRightCorner<3, 3>() = hx;
+    I.bottomLeftCorner<3, 3>() = hx.transpose();
+    I.bottomRightCorner<3, 3>() = l.mass * Eigen::Matrix3d::Identity();
+  }
+}
+
+// The composite-rigid-body algorithm on the world-frame quantities above: with Ic_j the summed
+// inertia of links j..n, M_ij = S_i . (Ic_j S_j) for i <= j (the inertias stay unchanged).
+void compositeRigidBody(const ManipulatorModel& model, ManipulatorData& data, bool motorInertia) {
+  const int n = data.n;
+  M6 Ic = M6::Zero();
+  for (int j = n - 1; j >= 0; --j) {
+    const auto k = static_cast<std::size_t>(j);
+    Ic += data.articulatedInertia[k];
+    const V6 F = Ic * data.motionSubspace[k];
+    for (int i = 0; i <= j; ++i) {
+      const double m = data.motionSubspace[static_cast<std::size_t>(i)].dot(F);
+      data.massMatrix(i, j) = m;
+      data.massMatrix(j, i) = m;
+    }
+    if (motorInertia) data.massMatrix(j, j) += model.getArmatureInertia()(j);
+  }
+}
+
+}  // namespace
+
 const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                               bool motorInertia) {
-  // M = sum over links k of m_k Jv_k^T Jv_k + Jw_k^T I_k Jw_k, with the Jacobians of each link's
-  // centre of mass in the world frame: column j <= k is (z_j x (c_k - p_j), z_j) for a revolute
-  // joint and (z_j, 0) for a prismatic one, z_j and p_j joint j's axis and a point on it.
   forwardKinematics(model, data, q);
-  const int n = data.n;
-  data.massMatrix.setZero();
-  for (int k = 0; k < n; ++k) {
-    const LinkParameters& l = model.getLink(k);
-    const Transform& Tk = data.linkTransforms[static_cast<std::size_t>(k)];
-    const Eigen::Matrix3d Rk = Tk.topLeftCorner<3, 3>();
-    const V3 c = Rk * Eigen::Vector3d(l.com) + Tk.topRightCorner<3, 1>();
-    const Eigen::Matrix3d I = Rk * Eigen::Matrix3d(l.inertia) * Rk.transpose();
-    for (int j = 0; j <= k; ++j) {
-      const auto jj = static_cast<std::size_t>(j);
-      const Transform& axis = internal::axisFrame(model, data, j);
-      const V3 z = axis.block<3, 1>(0, 2);
-      if (model.isPrismatic(j)) {
-        data.pstar[jj] = z;            // Jv column
-        data.wd[jj].setZero();         // Jw column
-      } else {
-        data.pstar[jj] = z.cross(c - V3(axis.topRightCorner<3, 1>()));
-        data.wd[jj] = z;
-      }
-      data.w[jj] = I * data.wd[jj];  // I Jw column
-    }
-    for (int i = 0; i <= k; ++i) {
-      const V3& vi = data.pstar[static_cast<std::size_t>(i)];
-      const V3& zi = data.wd[static_cast<std::size_t>(i)];
-      for (int j = 0; j <= i; ++j) {
-        const double m = l.mass * vi.dot(data.pstar[static_cast<std::size_t>(j)]) + zi.dot(data.w[static_cast<std::size_t>(j)]);
-        data.massMatrix(i, j) += m;
-      }
-    }
-  }
-  for (int i = 0; i < n; ++i) {
-    if (motorInertia) data.massMatrix(i, i) += model.getArmatureInertia()(i);
-    for (int j = 0; j < i; ++j) data.massMatrix(j, i) = data.massMatrix(i, j);
-  }
+  worldSubspacesAndInertias(model, data);
+  compositeRigidBody(model, data, motorInertia);
   return data.massMatrix;
 }
 
@@ -185,6 +209,83 @@ const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorDat
   massMatrix(model, data, q, options.motorInertia);
   data.ldlt.compute(data.massMatrix);
   data.ldlt.solveInPlace(data.qdd);
+  return data.qdd;
+}
+
+
+const JointVector& forwardDynamicsArticulatedBody(const ManipulatorModel& model, ManipulatorData& data,
+                                                  const JointVector& q, const JointVector& qd, const JointVector& tau,
+                                                  const DynamicsOptions& options) {
+  // Featherstone's articulated-body algorithm with every spatial vector (angular; linear) in world
+  // coordinates at the world origin: no coordinate transforms between links, so articulated
+  // inertias and bias forces add directly into the parent and accelerations carry over as they are.
+  const int n = data.n;
+  forwardKinematics(model, data, q);
+
+  worldSubspacesAndInertias(model, data);
+
+  // Pass 1, outward: velocities, velocity-product accelerations c_i = v_i x S_i qd_i and bias
+  // forces v_i x* (I_i v_i).
+  V3 w = V3::Zero(), v = V3::Zero();
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const V6& S = data.motionSubspace[k];
+    const V3 vjw = S.head<3>() * qd(i), vjv = S.tail<3>() * qd(i);
+    w += vjw;
+    v += vjv;
+    data.biasAcceleration[k] << w.cross(vjw), w.cross(vjv) + v.cross(vjw);
+    // With I v = (nI; fI): v x* (I v) = (w x nI + v x fI; w x fI).
+    const M6& I = data.articulatedInertia[k];
+    const V3 nI = I.topLeftCorner<3, 3>() * w + I.topRightCorner<3, 3>() * v;
+    const V3 fI = I.bottomLeftCorner<3, 3>() * w + I.bottomRightCorner<3, 3>() * v;
+    data.biasForce[k] << w.cross(nI) + v.cross(fI), w.cross(fI);
+  }
+  // The tip wrench the last link exerts on its environment (at link frame n's origin, in its
+  // coordinates) is an external force of minus it: it adds to that link's bias force.
+  {
+    const Transform& T = data.linkTransforms[static_cast<std::size_t>(n - 1)];
+    const V3 f = T.topLeftCorner<3, 3>() * options.tipWrench.head<3>();
+    V6& pA = data.biasForce[static_cast<std::size_t>(n - 1)];
+    pA.head<3>() += T.topLeftCorner<3, 3>() * options.tipWrench.tail<3>() + V3(T.topRightCorner<3, 1>()).cross(f);
+    pA.tail<3>() += f;
+  }
+
+  // Pass 2, inward: articulated inertias and bias forces, added straight into the parent's.
+  for (int i = n - 1; i >= 0; --i) {
+    const auto k = static_cast<std::size_t>(i);
+    const LinkParameters& l = model.getLink(i);
+    const V6& S = data.motionSubspace[k];
+    const M6& IA = data.articulatedInertia[k];
+    const V6& pA = data.biasForce[k];
+    V6& U = data.inertiaTimesS[k];
+    U.noalias() = IA * S;
+    double D = S.dot(U);
+    if (options.motorInertia) D += model.getArmatureInertia()(i);
+    double u = tau(i) - S.dot(pA);
+    if (options.friction) u -= jointFriction(l, qd(i));
+    data.abaD(i) = D;
+    data.abaU(i) = u;
+    if (i == 0) break;
+    // Ia = IA - U U^T / D and pa = pA + Ia c + U u / D go into the parent.
+    M6& parent = data.articulatedInertia[k - 1];
+    parent += IA;
+    parent.noalias() -= (U / D) * U.transpose();
+    V6& parentBias = data.biasForce[k - 1];
+    parentBias += pA + U * (u / D);
+    parentBias.noalias() += IA * data.biasAcceleration[k];
+    parentBias.noalias() -= U * (U.dot(data.biasAcceleration[k]) / D);
+  }
+
+  // Pass 3, outward: accelerations from the base's -g.
+  V6 a = V6::Zero();
+  if (options.gravity) a.tail<3>() = -model.getGravity();
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    a += data.biasAcceleration[k];
+    const double qddi = (data.abaU(i) - data.inertiaTimesS[k].dot(a)) / data.abaD(i);
+    data.qdd(i) = qddi;
+    a += data.motionSubspace[k] * qddi;
+  }
   return data.qdd;
 }
 

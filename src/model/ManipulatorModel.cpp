@@ -61,7 +61,7 @@ ManipulatorData::ManipulatorData(const ManipulatorModel& model) : n(model.getNum
   linkTransforms.fill(Transform::unit());
   endEffector = Transform::unit();
   jacobian = Jacobian(6, n);
-  for (JointVector* v : {&tau, &qdd, &scratchTau, &zero, &unitColumn}) v->setZero(n);
+  for (JointVector* v : {&tau, &qdd, &scratchTau, &zero, &unitColumn, &abaD, &abaU}) v->setZero(n);
   massMatrix.setZero(n, n);
 }
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <kdl/chaindynparam.hpp>
+#include <kdl/chainfdsolver_recursive_newton_euler.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
@@ -51,9 +52,10 @@ TEST_P(KdlComparison, AgreesOnRandomConfigurations) {
   KDL::ChainJntToJacSolver jac(chain);
   KDL::ChainIdSolver_RNE id(chain, KDL::Vector(0, 0, -9.81));
   KDL::ChainDynParam dyn(chain, KDL::Vector(0, 0, -9.81));
+  KDL::ChainFdSolver_RNE fdKdl(chain, KDL::Vector(0, 0, -9.81));
   std::mt19937_64 rng(2024);
   std::uniform_real_distribution<double> u(-1, 1);
-  double worstFk = 0, worstJ = 0, worstTau = 0, worstM = 0;
+  double worstFk = 0, worstJ = 0, worstTau = 0, worstM = 0, worstFd = 0;
   for (int trial = 0; trial < 1000; ++trial) {
     JointVector q(n), qd(n), qdd(n);
     for (int i = 0; i < n; ++i) {
@@ -93,7 +95,19 @@ TEST_P(KdlComparison, AgreesOnRandomConfigurations) {
     const JointMatrix& M = massMatrix(*model, data, q);
     for (int r = 0; r < n; ++r)
       for (int c = 0; c < n; ++c) worstM = std::max(worstM, std::abs(M(r, c) - km(static_cast<unsigned>(r), static_cast<unsigned>(c))));
+
+    // Forward dynamics of the torques above (both of our algorithms), relative to the size of qdd.
+    KDL::JntArray kqddBack(static_cast<unsigned>(n));
+    ASSERT_GE(fdKdl.CartToJnt(kq, kqd, ktau, noWrench, kqddBack), 0);
+    const JointVector t = tau;
+    const JointVector fd1 = forwardDynamics(*model, data, q, qd, t);
+    const JointVector fd2 = forwardDynamicsArticulatedBody(*model, data, q, qd, t);
+    for (int i = 0; i < n; ++i) {
+      const double k = kqddBack(static_cast<unsigned>(i)), scale = 1 + std::abs(k);
+      worstFd = std::max({worstFd, std::abs(fd1(i) - k) / scale, std::abs(fd2(i) - k) / scale});
+    }
   }
+  EXPECT_LT(worstFd, 1e-9);
   EXPECT_LT(worstFk, 1e-9);
   EXPECT_LT(worstJ, 1e-9);
   EXPECT_LT(worstTau, 1e-9);

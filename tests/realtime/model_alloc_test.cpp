@@ -39,6 +39,7 @@ TEST(ModelRealtime, AlgorithmsDoNotAllocate) {
     sink += massMatrix(puma, pd, q, true)(0, 0);
     sink += forwardDynamics(puma, pd, q, qd, tau, all)(2);
     sink += forwardDynamics(wam, wd, wq, JointVector(7), JointVector(7))(3);
+    sink += forwardDynamicsArticulatedBody(puma, pd, q, qd, tau, all)(2);
     sink += puma.inverseKinematicsAll(target, branches) == IkStatus::Solved;
     sink += puma.inverseKinematicsClosest(target, q, out) == IkStatus::Solved;
     sink += inverseKinematics(wam, wd, wamTarget, wq, wout) == IkStatus::Solved;
@@ -101,6 +102,7 @@ TEST(ModelRealtime, PrismaticAndModifiedDhAlgorithmsDoNotAllocate) {
     coriolisTorque(arm, d, q, qd, out);
     sink += massMatrix(arm, d, q, true)(1, 1);
     sink += forwardDynamics(arm, d, q, qd, out, all)(3);
+    sink += forwardDynamicsArticulatedBody(arm, d, q, qd, out, all)(3);
     sink += inverseKinematics(arm, d, target, q, out, position) == IkStatus::Solved;
   }
   EXPECT_EQ(guard.count(), 0u);

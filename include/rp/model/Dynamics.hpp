@@ -58,8 +58,9 @@ void coriolisTorque(const ManipulatorModel& model, ManipulatorData& data, const 
                     JointVector& tau);
 
 /// The joint-space mass matrix \f$M(q)\f$ (symmetric, positive definite), optionally with the
-/// reflected motor inertia on its diagonal. Computed from the links' centre-of-mass Jacobians,
-/// \f$M = \sum_k m_k J_{v,k}^T J_{v,k} + J_{\omega,k}^T I_k J_{\omega,k}\f$ (an algorithm
+/// reflected motor inertia on its diagonal, by the composite-rigid-body algorithm with spatial
+/// vectors in world coordinates: \f$M_{ij} = S_i^T I^c_j S_j\f$ (\f$i \le j\f$) with \f$S\f$ the
+/// joints' motion subspaces and \f$I^c_j\f$ the summed inertia of links j..n (an algorithm
 /// independent of the Newton-Euler one, which the tests compare it with).
 /// @param[in]  model         the manipulator
 /// @param[out] data          receives `massMatrix` (n x n) [kg m^2] and the forward kinematics of `q`
@@ -72,17 +73,36 @@ const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& da
 
 /// Forward dynamics: the accelerations \f$\ddot q = M^{-1}(\tau - h(q, \dot q))\f$ that the
 /// torques `tau` produce, with \f$h\f$ the Newton-Euler torques at \f$\ddot q = 0\f$ and the
-/// effects in `options` (with motorInertia, \f$M\f$ includes \f$G^2 J_m\f$).
+/// effects in `options` (with motorInertia, \f$M\f$ includes \f$G^2 J_m\f$): \f$h\f$ by
+/// Newton-Euler, \f$M\f$ by massMatrix() and an LDL^T solve. At an equilibrium (`tau` equal to
+/// the Newton-Euler torques at rest) the accelerations are exactly zero, which simulations with
+/// discontinuous Coulomb friction rely on; forwardDynamicsArticulatedBody() is faster but leaves
+/// rounding residues there.
 /// @param[in]  model    the manipulator
 /// @param[out] data     receives `qdd` and `massMatrix`
-/// @param[in]  q        joint angles (n x 1) [rad]
-/// @param[in]  qd       joint velocities (n x 1) [rad/s]
-/// @param[in]  tau      applied joint torques (n x 1) [N m]
+/// @param[in]  q        joint positions (n x 1) [rad or m]
+/// @param[in]  qd       joint velocities (n x 1) [rad/s or m/s]
+/// @param[in]  tau      applied joint torques (n x 1) [N m or N]
 /// @param[in]  options  effects to include
-/// @return `data.qdd` [rad/s^2]
+/// @return `data.qdd` [rad/s^2 or m/s^2]
 /// Real-time safe: yes.
 const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                                    const JointVector& qd, const JointVector& tau,
                                    const DynamicsOptions& options = DynamicsOptions());
+
+/// The same forward dynamics by Featherstone's articulated-body algorithm: O(n), three passes over
+/// the links with spatial vectors in world coordinates, no mass matrix (`data.massMatrix` is not
+/// touched). Agrees with forwardDynamics() to rounding.
+/// @param[in]  model    the manipulator
+/// @param[out] data     receives `qdd`
+/// @param[in]  q        joint positions (n x 1) [rad or m]
+/// @param[in]  qd       joint velocities (n x 1) [rad/s or m/s]
+/// @param[in]  tau      applied joint torques (n x 1) [N m or N]
+/// @param[in]  options  effects to include
+/// @return `data.qdd` [rad/s^2 or m/s^2]
+/// Real-time safe: yes.
+const JointVector& forwardDynamicsArticulatedBody(const ManipulatorModel& model, ManipulatorData& data,
+                                                  const JointVector& q, const JointVector& qd, const JointVector& tau,
+                                                  const DynamicsOptions& options = DynamicsOptions());
 
 }  // namespace rp

@@ -39,6 +39,11 @@ struct ManipulatorData {
   std::array<Vector<3>, kMaxJoints> w, wd, vd;  // angular velocity, acceleration, linear acceleration
   std::array<Vector<3>, kMaxJoints> F, N;       // inertial force and moment at the centre of mass
   JointVector scratchTau, zero, unitColumn;
+  // Scratch of the articulated-body algorithm, per link, at the link frame's origin in link
+  // coordinates; spatial vectors as (angular; linear).
+  std::array<Eigen::Matrix<double, 6, 6>, kMaxJoints> articulatedInertia;
+  std::array<Eigen::Matrix<double, 6, 1>, kMaxJoints> biasForce, motionSubspace, biasAcceleration, inertiaTimesS;
+  JointVector abaD, abaU;
   Eigen::LDLT<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJoints, kMaxJoints>> ldlt;
   /// @endcond
 };
