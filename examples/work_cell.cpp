@@ -71,6 +71,9 @@ int main(int argc, char* argv[]) {
     ++cycles;
   }
   puma.clearTrajectoryGenerator();
-  std::cout << "work_cell: " << cycles << " cycles done" << std::endl;
+  const ControlStatistics st = puma.getStatistics();
+  std::cout << "work_cell: " << cycles << " cycles done; servo loop: " << st.cycles << " cycles, " << st.overruns
+            << " overruns, computation p99 " << st.computationTime.p99 << " us, wake-up latency p99 "
+            << st.wakeupLatency.p99 << " us, max " << st.wakeupLatency.max << " us" << std::endl;
   return 0;
 }

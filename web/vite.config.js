@@ -1,4 +1,4 @@
-// Vite build of the Scene Viewer front end: one page per window (viewer, Joint Move).
+// Vite build of the Scene Viewer front end: one page per window (viewer, Joint Move, QMotor).
 import { resolve } from 'node:path';
 import { defineConfig } from 'vite';
 
@@ -11,6 +11,7 @@ export default defineConfig({
       input: {
         index: resolve(__dirname, 'index.html'),
         jointmove: resolve(__dirname, 'jointmove.html'),
+        qmotor: resolve(__dirname, 'qmotor.html'),
       },
     },
   },

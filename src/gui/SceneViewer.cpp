@@ -744,6 +744,13 @@ void SceneViewer::startFromPlatform() {
   static std::once_flag atExit;
   std::call_once(atExit, [] { std::atexit([] { instance().stop(); }); });
   std::cerr << "rp: Scene Viewer at " << instance().getUrl() << std::endl;
+  if (RoboticPlatform::isQMotorOn()) {  // -qmotor: the plots and tuning window
+    const std::string url = instance().getUrl();
+    const std::string token = instance().getToken();
+    const std::size_t root = url.find('/', url.find("//") + 2);  // end of http://host:port
+    std::cerr << "rp: QMotor at " << url.substr(0, root) << "/qmotor.html" << (token.empty() ? "" : "?token=" + token)
+              << std::endl;
+  }
 }
 
 namespace {

@@ -53,6 +53,7 @@ view.renderer.domElement.addEventListener('contextmenu', (ev) => {
   if (name) showMenu(name, ev.clientX, ev.clientY);
 });
 document.getElementById('new-view').href = location.href;
+document.getElementById('qmotor-link').href = `qmotor.html${location.search}`;
 document.getElementById('toggle-list').addEventListener('click', () =>
   document.getElementById('list-window').classList.toggle('hidden'));
 

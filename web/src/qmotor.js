@@ -1,0 +1,131 @@
+// QMotor window: live plots (uPlot) of an object's state values and its tunable parameters.
+// The values come with the state frames (60 Hz); the last 10 s are shown.
+import 'uplot/dist/uPlot.min.css';
+import uPlot from 'uplot';
+import './style.css';
+import { Connection } from './connection.js';
+import { ControlPanel } from './panels.js';
+import { notify, showStatus } from './ui.js';
+
+const params = new URLSearchParams(location.search);
+const select = document.getElementById('object');
+const fieldsEl = document.getElementById('fields');
+const plotEl = document.getElementById('plot');
+const HISTORY = 600; // samples kept (10 s at 60 Hz)
+let scene = null;
+let objectName = params.get('object');
+let chosen = new Set((params.get('fields') || '').split(',').filter(Boolean));
+let panel = null;
+let plot = null;
+let series = []; // [{label, index}]
+let data = [[]];
+let samples = 0;
+let dirty = false;
+
+function makePlot() {
+  if (plot) plot.destroy();
+  data = [[], ...series.map(() => [])];
+  const colors = ['#1f77b4', '#ff7f0e', '#2ca02c', '#d62728', '#9467bd', '#8c564b', '#e377c2', '#7f7f7f'];
+  plot = new uPlot({
+    width: plotEl.clientWidth || 700,
+    height: 320,
+    scales: { x: { time: false } },
+    axes: [{ label: 'time [s]' }, {}],
+    series: [{ label: 't' }, ...series.map((s, i) => ({ label: s.label, stroke: colors[i % colors.length], width: 1.5 }))],
+  }, data, plotEl);
+}
+
+function buildFields(desc) {
+  const fields = desc.panel.fields.filter((f) => f.stateIndex >= 0 && (f.kind === 'vector' || f.kind === 'number'));
+  if (!chosen.size && fields.length) chosen = new Set([fields[0].name]);
+  const boxes = fields.map((f) => {
+    const label = document.createElement('label');
+    const box = document.createElement('input');
+    box.type = 'checkbox';
+    box.dataset.field = f.name;
+    box.checked = chosen.has(f.name);
+    box.addEventListener('change', () => {
+      if (box.checked) chosen.add(f.name);
+      else chosen.delete(f.name);
+      buildSeries(desc);
+    });
+    label.append(box, ` ${f.label}${f.unit ? ` [${f.unit}]` : ''}`);
+    return label;
+  });
+  fieldsEl.replaceChildren(...boxes);
+  buildSeries(desc);
+}
+
+function buildSeries(desc) {
+  series = [];
+  for (const f of desc.panel.fields)
+    if (chosen.has(f.name) && f.stateIndex >= 0)
+      for (let i = 0; i < (f.kind === 'vector' ? f.size : 1); ++i)
+        series.push({ label: f.kind === 'vector' ? `${f.name}[${i}]` : f.name, index: f.stateIndex + i });
+  makePlot();
+}
+
+function choose(name) {
+  const desc = scene.objects.find((o) => o.name === name);
+  if (!desc) return;
+  objectName = name;
+  select.value = name;
+  document.getElementById('plot-info').textContent = `${desc.name} (${desc.className})`;
+  if (panel) panel.close();
+  panel = new ControlPanel(conn, name, notify, () => {});
+  panel.setDesc(desc);
+  buildFields(desc);
+}
+
+select.addEventListener('change', () => {
+  chosen = new Set();
+  choose(select.value);
+});
+
+const conn = new Connection({
+  onStatus: showStatus,
+  onScene: (s) => {
+    const first = !scene;
+    scene = s;
+    const candidates = s.objects.filter((o) => o.panel.fields.some((f) => f.stateIndex >= 0));
+    select.replaceChildren(...candidates.map((o) => new Option(`${o.name} (${o.className})`, o.name)));
+    if (first || !candidates.some((o) => o.name === objectName)) {
+      choose(objectName && candidates.some((o) => o.name === objectName) ? objectName : candidates[0] && candidates[0].name);
+    } else {
+      select.value = objectName;
+      const desc = s.objects.find((o) => o.name === objectName);
+      if (desc && panel) panel.setDesc(desc);
+    }
+  },
+  onFrame: (f) => {
+    if (!scene || !plot) return;
+    const o = f.objects.find((x) => scene.objects[x.index] && scene.objects[x.index].name === objectName);
+    if (!o) return;
+    if (panel) panel.setValues(o.values);
+    data[0].push(f.time);
+    series.forEach((s, i) => data[i + 1].push(o.values[s.index]));
+    if (data[0].length > HISTORY) for (const d of data) d.shift();
+    samples++;
+    dirty = true;
+  },
+  onError: notify,
+});
+
+const redraw = () => {
+  requestAnimationFrame(redraw);
+  if (dirty && plot) {
+    plot.setData(data);
+    dirty = false;
+  }
+};
+redraw();
+new ResizeObserver(() => plot && plot.setSize({ width: plotEl.clientWidth || 700, height: 320 })).observe(plotEl);
+
+window.rp = {
+  conn,
+  get scene() { return scene; },
+  get frames() { return conn.frames; },
+  get samples() { return samples; },
+  get series() { return series.map((s) => s.label); },
+  get data() { return data; },
+};
