@@ -143,6 +143,24 @@ Eigen::Matrix3d skew(const V3& v) {
   return m;
 }
 
+// Forward kinematics from the link transforms A_i = (data.R, data.pstar) of the last Newton-Euler
+// pass: data.linkTransforms and data.endEffector, as forwardKinematics() would give them.
+void composeLinkTransforms(const ManipulatorModel& model, ManipulatorData& data) {
+  const Transform* previous = &model.getBaseTransform();
+  for (int i = 0; i < data.n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    Transform& T = data.linkTransforms[k];
+    T.topLeftCorner<3, 3>().noalias() = previous->topLeftCorner<3, 3>() * data.R[k];
+    T.topRightCorner<3, 1>() = previous->topLeftCorner<3, 3>() * data.pstar[k] + previous->topRightCorner<3, 1>();
+    T.row(3) << 0, 0, 0, 1;
+    previous = &T;
+  }
+  const Transform& tool = model.getToolTransform();
+  data.endEffector.topRows<3>().noalias() = previous->topLeftCorner<3, 3>() * tool.topRows<3>();
+  data.endEffector.topRightCorner<3, 1>() += previous->topRightCorner<3, 1>();
+  data.endEffector.row(3) << 0, 0, 0, 1;
+}
+
 // After forwardKinematics(): each joint's motion subspace S_i and each link's rigid spatial
 // inertia, as spatial vectors (angular; linear) in world coordinates at the world origin.
 // S_i = (z; o x z) for a rotation about the line through o along z, (0; z) for a translation.
@@ -206,7 +224,10 @@ const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorDat
   // qdd holds tau - h until it is solved in place (massMatrix() uses scratchTau).
   rnea(model, data, q, qd, data.zero, options.gravity, false, options.friction, &options.tipWrench, data.qdd);
   data.qdd = tau - data.qdd;
-  massMatrix(model, data, q, options.motorInertia);
+  // The mass matrix from the link transforms Newton-Euler left in data.R / data.pstar (no trigonometry).
+  composeLinkTransforms(model, data);
+  worldSubspacesAndInertias(model, data);
+  compositeRigidBody(model, data, options.motorInertia);
   data.ldlt.compute(data.massMatrix);
   data.ldlt.solveInPlace(data.qdd);
   return data.qdd;
