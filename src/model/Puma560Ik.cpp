@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "ChainInternal.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/Puma560Model.hpp"
 
@@ -34,7 +35,6 @@ IkStatus Puma560Model::inverseKinematicsAll(const Transform& pose, std::array<Pu
   const double r2 = px * px + py * py - d3 * d3;
   if (r2 < 0) return IkStatus::Unreachable;
   const double rho = std::hypot(a3, d4), phi = std::atan2(d4, a3);
-  ManipulatorData data(*this);
   int k = 0;
   for (int shoulder = 0; shoulder < 2; ++shoulder) {
     const double X = shoulder == 1 ? std::sqrt(r2) : -std::sqrt(r2);
@@ -51,10 +51,15 @@ IkStatus Puma560Model::inverseKinematicsAll(const Transform& pose, std::array<Pu
       // Wrist: R36 = R03^T R06 = Rz(q4) Ry(-q5) Rz(q6).
       JointVector q(6);
       q << q1, q2, q3, 0, 0, 0;
-      forwardKinematics(*this, data, q);
-      const Transform R03 = rigidInverse(getBaseTransform()) * data.linkTransforms[2];
+      // R03 = rotation of A1 A2 A3 (frame 3 in the base frame).
+      Eigen::Matrix3d R03 = Eigen::Matrix3d::Identity();
+      for (int i = 0; i < 3; ++i) {
+        Eigen::Matrix<double, 3, 4> A;
+        internal::linkMatrix(*this, i, q(i), A);
+        R03 = R03 * A.leftCols<3>();
+      }
       Transform R36 = Transform::unit();
-      R36.topLeftCorner<3, 3>() = R03.topLeftCorner<3, 3>().transpose() * T6.topLeftCorner<3, 3>();
+      R36.topLeftCorner<3, 3>() = R03.transpose() * T6.topLeftCorner<3, 3>();
       const Vector<3> e = transformToEuler(R36);  // (phi, theta, psi), theta in [0, pi]
       for (int flip = 0; flip < 2; ++flip) {
         Puma560IkSolution& s = solutions[static_cast<std::size_t>(k++)];
