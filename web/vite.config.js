@@ -1,4 +1,4 @@
-// Vite build of the Scene Viewer front end: one page per window (viewer, Joint Move, QMotor).
+// Vite build of the Scene Viewer front end: one page per window (viewer, Joint Move, QMotor, Teachpendant).
 import { resolve } from 'node:path';
 import { defineConfig } from 'vite';
 
@@ -12,6 +12,7 @@ export default defineConfig({
         index: resolve(__dirname, 'index.html'),
         jointmove: resolve(__dirname, 'jointmove.html'),
         qmotor: resolve(__dirname, 'qmotor.html'),
+        teachpendant: resolve(__dirname, 'teachpendant.html'),
       },
     },
   },

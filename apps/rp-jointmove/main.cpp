@@ -22,6 +22,7 @@
 #include "rp/core/Core.hpp"
 #include "rp/gui/SceneViewer.hpp"
 #include "rp/manipulator/Manipulators.hpp"
+#include "ChooseManipulator.hpp"
 
 namespace {
 
@@ -138,65 +139,13 @@ const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The manipulator's name picks the page the printed URL opens: look at the arguments first.
-  std::string name;
-  {
-    std::vector<std::string> args(argv + 1, argv + argc);
-    try {
-      auto rest = rp::RoboticPlatform::parseCommandLine(args);
-      if (!rest.empty()) name = rest.front();
-    } catch (const std::exception&) {
-      // init() reports it
-    }
-  }
-  rp::SceneViewer::setStartPage("jointmove.html" + (name.empty() ? std::string() : "?object=" + name));
-  rp::RoboticPlatform::init(argc, argv, kUsage);
-  if (argc > 2) {
-    std::cerr << "rp-jointmove: unexpected argument '" << argv[2] << "' (usage: rp-jointmove [-config FILE] [NAME])\n";
-    return 2;
-  }
-  rp::ObjectManager om;
-  rp::Manipulator* arm = nullptr;
-  std::unique_ptr<rp::Puma560> ownPuma;
-  try {
-    if (argc == 2) {
-      arm = om.createDerivedObject<rp::Manipulator>(argv[1]);
-    } else {
-      for (const auto& section : rp::RoboticPlatform::getConfiguration().sections()) {
-        const rp::TypeInfo* info = rp::ObjectManager::getTypeDatabase().find(section.className());
-        bool isManipulator = false;
-        if (info) {
-          try {
-            info->throwNullPointer();
-          } catch (rp::Manipulator*) {
-            isManipulator = true;
-          } catch (...) {
-          }
-        }
-        if (isManipulator) {
-          arm = om.createDerivedObject<rp::Manipulator>(section.name());
-          break;
-        }
-      }
-      if (!arm) {
-        ownPuma = std::make_unique<rp::Puma560>("puma");
-        arm = ownPuma.get();
-      }
-    }
-  } catch (const std::exception& e) {
-    std::cerr << "rp-jointmove: " << e.what() << "\n";
-    return 2;
-  }
-  const std::string armName = arm->getName();
+  std::unique_ptr<rp::Manipulator> ownArm;
+  rp::Manipulator* arm = rp::apps::startUtility("rp-jointmove", "jointmove.html", argc, argv, kUsage, ownArm);
+  if (!arm) return 2;
   JointFollower follower("jointmove", arm->getModel(), arm->getJointPosition());
   arm->setTrajectoryGenerator(follower);
-  std::cout << "rp-jointmove: moving " << armName << " (" << arm->getClassName() << ", " << arm->getNumberOfJoints()
-            << " joints)";
   // Without NAME the page shows the first manipulator: this one.
-  if (rp::SceneViewer::instance().isRunning()) std::cout << ": open " << rp::SceneViewer::instance().getUrl();
-  std::cout << "; Ctrl-C ends it" << std::endl;
-  while (!rp::ObjectManager::isShutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  rp::ObjectManager::waitForShutdown(10);
+  rp::apps::runUntilShutdown("rp-jointmove", "moving", *arm);
   arm->clearTrajectoryGenerator();
   return 0;
 }

@@ -85,8 +85,14 @@ export async function openViewer(browser, url, { width = 1000, height = 700 } = 
 
 // Waits until `predicate` (run in the page with `arg`) is true; returns its last value.
 export async function waitInPage(page, predicate, arg, timeout = 15000) {
-  const handle = await page.waitForFunction(predicate, arg, { timeout, polling: 50 });
-  return handle.jsonValue();
+  try {
+    const handle = await page.waitForFunction(predicate, arg, { timeout, polling: 50 });
+    return await handle.jsonValue();
+  } catch (e) {
+    const state = await page.evaluate(() => JSON.stringify({ connected: window.rp && window.rp.conn.connected,
+      frames: window.rp && window.rp.frames, state: window.rp && window.rp.state })).catch(() => 'page gone');
+    throw new Error(`not true within ${timeout} ms: ${predicate} (arg ${JSON.stringify(arg)}); page: ${state}`);
+  }
 }
 
 // Non-background pixels and a coarse signature of the 3D view (read back from the WebGL canvas).
@@ -164,6 +170,7 @@ export function withProgram(program, args) {
     if (ctx.browser) await ctx.browser.close();
     if (ctx.program) {
       const r = await ctx.program.stop();
+      console.log(`--- ${program} output ---\n${ctx.program.output()}`);
       assert.ok(r.code === 0 || r.code === 143 || r.signal === 'SIGTERM',
         `${program} ended with ${JSON.stringify(r)}:\n${ctx.program.output()}`);
     }

@@ -1,0 +1,205 @@
+// rp-teachpendant [-config FILE] [NAME]: the Teachpendant (paper section 4.2, Figure 20).
+//
+// Creates the manipulator NAME (as rp-jointmove does) and opens the Scene Viewer on the
+// Teachpendant page: switch zero-gravity mode on and push the arm around (in simulation: drag
+// the end-effector with Shift held, which applies a force to it), store the current position in
+// a list, move back to a stored position with the trajectory generator, cycle through all or
+// selected positions. Runs until Ctrl-C (SIGINT) or SIGTERM.
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "ChooseManipulator.hpp"
+#include "rp/core/Core.hpp"
+#include "rp/gui/SceneViewer.hpp"
+#include "rp/manipulator/Manipulators.hpp"
+
+namespace {
+
+using nlohmann::json;
+
+// The Teachpendant's state and commands; the GUI reaches it with `message` requests (they run in
+// the viewer's worker thread, one at a time). Motions run in a thread of their own.
+class Teachpendant : public rp::RoboticObject {
+ public:
+  Teachpendant(const std::string& name, rp::Manipulator& arm) : rp::RoboticObject(name), arm_(arm) {}
+  ~Teachpendant() override {
+    abort_ = true;
+    if (job_.joinable()) job_.join();
+    generator_.reset();
+    arm_.clearExternalWrench();
+  }
+
+  bool handleMessage(const std::string& type, const std::string& payload, std::string& reply) override {
+    json j = payload.empty() ? json::object() : json::parse(payload, nullptr, false);
+    if (j.is_discarded()) throw std::invalid_argument(type + ": the payload is not JSON");
+    reply.clear();
+    if (type == "read") {
+      reply = state().dump();
+    } else if (type == "zeroGravity") {
+      if (!j.is_boolean()) throw std::invalid_argument("zeroGravity needs true or false");
+      if (busy()) throw std::invalid_argument("the arm is moving to a stored position");
+      if (j.get<bool>()) arm_.setZeroGravityModeOn();
+      else arm_.setZeroGravityModeOff();
+    } else if (type == "push") {
+      if (!arm_.isSimulationModeOn()) throw std::invalid_argument("pushing the arm from the browser works in simulation only");
+      if (!j.is_object() || !j.contains("force") || !j["force"].is_array() || j["force"].size() != 3)
+        throw std::invalid_argument("push needs {\"force\": [fx, fy, fz]} in newtons");
+      rp::Vector<6> wrench;
+      for (int i = 0; i < 3; ++i) {
+        const json& f = j["force"][static_cast<std::size_t>(i)];
+        if (!f.is_number() || !std::isfinite(f.get<double>()) || std::abs(f.get<double>()) > kMaxForce)
+          throw std::invalid_argument("push: each force component must be a number within +-" + std::to_string(kMaxForce) + " N");
+        wrench(i) = f.get<double>();
+      }
+      arm_.applyExternalWrench(wrench);
+    } else if (type == "store") {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (positions_.size() >= 1000) throw std::invalid_argument("the list is full (1000 positions)");
+      std::string label(1, 'P');  // (not "P" + ...: GCC 12 -Wrestrict false positive at -O3)
+      label += std::to_string(++stored_);
+      if (j.is_object() && j.contains("name")) {
+        if (!j["name"].is_string() || j["name"].get<std::string>().empty() || j["name"].get<std::string>().size() > 64)
+          throw std::invalid_argument("store: 'name' must be a string of 1 to 64 characters");
+        label = j["name"].get<std::string>();
+      }
+      positions_.push_back({label, arm_.getJointPosition()});
+    } else if (type == "delete") {
+      std::lock_guard<std::mutex> lock(mutex_);
+      positions_.erase(positions_.begin() + static_cast<long>(index(j)));
+    } else if (type == "goto") {
+      std::size_t i;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        i = index(j);
+      }
+      start({i}, 1);
+    } else if (type == "cycle") {
+      std::vector<std::size_t> which;
+      int times = 1;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (j.is_object() && j.contains("indices")) {
+          if (!j["indices"].is_array()) throw std::invalid_argument("cycle: 'indices' must be an array");
+          for (const json& k : j["indices"]) which.push_back(index(json{{"index", k}}));
+        }
+        if (which.empty())
+          for (std::size_t k = 0; k < positions_.size(); ++k) which.push_back(k);
+        if (which.empty()) throw std::invalid_argument("cycle: no stored positions");
+      }
+      if (j.is_object() && j.contains("times")) {
+        if (!j["times"].is_number_integer() || j["times"].get<int>() < 1 || j["times"].get<int>() > 100)
+          throw std::invalid_argument("cycle: 'times' must be 1 to 100");
+        times = j["times"].get<int>();
+      }
+      start(which, times);
+    } else if (type == "stop") {
+      abort_ = true;
+    } else {
+      return rp::RoboticObject::handleMessage(type, payload, reply);
+    }
+    if (reply.empty()) reply = state().dump();
+    return true;
+  }
+
+ private:
+  struct Position {
+    std::string name;
+    rp::JointVector q;
+  };
+  static constexpr double kMaxForce = 500;  // [N]
+
+  bool busy() const { return running_.load(); }
+
+  std::size_t index(const json& j) const {  // under mutex_
+    if (!j.is_object() || !j.contains("index") || !j["index"].is_number_integer())
+      throw std::invalid_argument("needs {\"index\": n}");
+    const long long i = j["index"].get<long long>();
+    if (i < 0 || i >= static_cast<long long>(positions_.size()))
+      throw std::invalid_argument("no stored position " + std::to_string(i) + " (" + std::to_string(positions_.size()) + " stored)");
+    return static_cast<std::size_t>(i);
+  }
+
+  json state() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    json list = json::array();
+    for (const Position& p : positions_) {
+      json q = json::array();
+      for (Eigen::Index i = 0; i < p.q.size(); ++i) q.push_back(p.q(i));
+      list.push_back({{"name", p.name}, {"q", q}});
+    }
+    return {{"zeroGravity", arm_.isZeroGravityModeOn()}, {"simulation", arm_.isSimulationModeOn()},
+            {"busy", running_.load()}, {"target", target_}, {"positions", list}};
+  }
+
+  // Moves through the positions `which`, `times` times, in a thread: a fresh trajectory generator
+  // each time, so that the first motion starts where the arm was pushed to.
+  void start(const std::vector<std::size_t>& which, int times) {
+    if (running_.exchange(true)) throw std::invalid_argument("the arm is already moving to a stored position");
+    if (job_.joinable()) job_.join();
+    std::vector<Position> targets;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (int t = 0; t < times; ++t)
+        for (std::size_t i : which) targets.push_back(positions_[i]);
+    }
+    abort_ = false;
+    arm_.clearExternalWrench();
+    arm_.setZeroGravityModeOff();
+    generator_.reset();
+    generator_ = std::make_unique<rp::DefaultTrajectoryGenerator<>>();
+    arm_.setTrajectoryGenerator(*generator_);
+    job_ = std::thread([this, targets] {
+      try {
+        for (const Position& p : targets) {
+          if (abort_ || rp::ObjectManager::isShutdownRequested()) break;
+          {
+            std::lock_guard<std::mutex> lock(mutex_);
+            target_ = p.name;
+          }
+          generator_->moveRadians(p.q);
+          generator_->stop(0.5);
+        }
+      } catch (const std::exception& e) {
+        std::cerr << "rp-teachpendant: " << e.what() << "\n";
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        target_.clear();
+      }
+      running_ = false;
+    });
+  }
+
+  rp::Manipulator& arm_;
+  mutable std::mutex mutex_;
+  std::vector<Position> positions_;
+  int stored_ = 0;
+  std::string target_;
+  std::unique_ptr<rp::DefaultTrajectoryGenerator<>> generator_;
+  std::thread job_;
+  std::atomic<bool> running_{false}, abort_{false};
+};
+
+const char* kUsage =
+    "rp-teachpendant [switches] [NAME]: teach the manipulator NAME (an rp.cfg section; default: the first manipulator "
+    "of rp.cfg, or a simulated Puma 560) positions in the browser; Ctrl-C ends it.";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::unique_ptr<rp::Manipulator> ownArm;
+  rp::Manipulator* arm = rp::apps::startUtility("rp-teachpendant", "teachpendant.html", argc, argv, kUsage, ownArm);
+  if (!arm) return 2;
+  Teachpendant pendant("teachpendant", *arm);
+  rp::apps::runUntilShutdown("rp-teachpendant", "teaching", *arm);
+  return 0;
+}

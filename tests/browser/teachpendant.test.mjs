@@ -1,0 +1,79 @@
+// Browser test of rp-teachpendant (Figure 20): zero-gravity mode, pushing the simulated arm by
+// dragging its end-effector, storing positions, moving back to one, cycling through them.
+import { describe, it } from 'node:test';
+import assert from 'node:assert/strict';
+import { join } from 'node:path';
+import { withProgram, waitInPage, sleep } from './harness.mjs';
+
+const shots = process.env.RP_SCREENSHOT_DIR;
+
+describe('rp-teachpendant', () => {
+  const ctx = withProgram('rp-teachpendant', ['-gui-port', '0']);
+  const joints = () => ctx.page.evaluate(() => {
+    const o = window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'puma');
+    return o.values.slice(0, 6);
+  });
+  const distance = (a, b) => Math.sqrt(a.reduce((s, x, i) => s + (x - b[i]) ** 2, 0));
+  const state = () => ctx.page.evaluate(() => window.rp.state);
+  const nearStored = (index, tolerance) => waitInPage(ctx.page, ([i, tol]) => {
+    const s = window.rp.state;
+    const o = window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'puma');
+    const q = s.positions[i].q;
+    return !s.busy && Math.sqrt(q.reduce((acc, x, k) => acc + (x - o.values[k]) ** 2, 0)) < tol;
+  }, [index, tolerance], 20000);
+
+  it('opens the Teachpendant page', async () => {
+    assert.match(ctx.url, /\/teachpendant\.html$/);
+    assert.match(ctx.program.output(), /rp-teachpendant: teaching puma \(Puma560, 6 joints\)/);
+    await waitInPage(ctx.page, () => window.rp.state !== null);
+    assert.deepEqual((await state()).positions, []);
+  });
+
+  it('stores a position, then in zero-gravity mode a Shift-drag pushes the arm away', async () => {
+    await ctx.page.click('#store');
+    await waitInPage(ctx.page, () => window.rp.state.positions.length === 1);
+    const q0 = await joints();
+    await ctx.page.click('#zero-g');
+    await waitInPage(ctx.page, () => window.rp.state.zeroGravity === true);
+    const ee = await ctx.page.evaluate(() => window.rp.endEffectorOnScreen());
+    await ctx.page.keyboard.down('Shift');
+    await ctx.page.mouse.move(ee.x, ee.y);
+    await ctx.page.mouse.down();
+    await ctx.page.mouse.move(ee.x + 40, ee.y + 20, { steps: 5 });
+    await sleep(1500); // the spring-damper brings the end-effector under the pointer
+    await ctx.page.mouse.up();
+    await ctx.page.keyboard.up('Shift');
+    await sleep(500);
+    const q1 = await joints();
+    assert.ok(distance(q0, q1) > 0.05, `the arm moved only ${distance(q0, q1)} rad`);
+    if (shots) await ctx.page.screenshot({ path: join(shots, 'teachpendant.png') });
+    await ctx.page.click('#store');
+    await waitInPage(ctx.page, () => window.rp.state.positions.length === 2);
+    const s = await state();
+    assert.deepEqual(s.positions.map((p) => p.name), ['P1', 'P2']);
+    assert.ok(distance(s.positions[0].q, s.positions[1].q) > 0.05);
+  });
+
+  it('moves back to a stored position with the trajectory generator', async () => {
+    await ctx.page.click('#positions tr[data-index="0"] button.go');
+    await waitInPage(ctx.page, () => window.rp.state.busy || window.rp.state.zeroGravity === false);
+    await nearStored(0, 0.01);
+    assert.equal((await state()).zeroGravity, false);
+  });
+
+  it('cycles through all positions and refuses bad requests', async () => {
+    await ctx.page.click('#cycle-all');
+    await waitInPage(ctx.page, () => window.rp.state.busy && window.rp.state.target === 'P2');
+    await nearStored(1, 0.01);
+    const bad = await ctx.page.evaluate(async () => {
+      const out = [];
+      for (const [t, p] of [['goto', { index: 7 }], ['push', { force: [1e6, 0, 0] }], ['cycle', { times: 0 }], ['zeroGravity', 'yes']])
+        out.push(await window.rp.conn.message('teachpendant', t, JSON.stringify(p)).then(() => 'accepted', (e) => e.message));
+      return out;
+    });
+    assert.match(bad[0], /no stored position 7/);
+    assert.match(bad[1], /within/);
+    assert.match(bad[2], /'times' must be 1 to 100/);
+    assert.match(bad[3], /true or false/);
+  });
+});
