@@ -33,6 +33,7 @@ void ManipulatorSimulation::step(const JointVector& tau, double dt) {
   if (brakes_) {
     qd_.setZero();
     qdd_.setZero();
+    tauExt_.setZero();  // the brakes take every load
     lastSubsteps_ = 1;
     return;
   }
