@@ -87,13 +87,19 @@ void putTransform(std::string& out, const Transform& t) {
 SceneState::SceneState() = default;
 SceneState::~SceneState() = default;
 
+// An object whose control loop has stopped is left alone: the destructors of objects with a loop
+// stop it first thing (RoboticObject::stopControlLoop), so this keeps the viewer off objects being
+// destroyed (the page keeps showing their last state). Objects without a loop have no such signal.
+bool SceneState::retiring(const Entry& e) { return e.program != nullptr && !e.program->isRunning(); }
+
 json SceneState::describe(Entry& e) {
   RoboticObject& o = *e.object;
   json j;
   j["path"] = "/objects/" + e.name;
   j["name"] = e.name;
   j["className"] = o.getClassName();
-  j["hasControlLoop"] = o.getControlProgram() != nullptr;
+  e.program = o.getControlProgram();
+  j["hasControlLoop"] = e.program != nullptr;
   e.physical = dynamic_cast<PhysicalObject*>(&o);
   e.manipulator = dynamic_cast<Manipulator*>(&o);
   j["physical"] = e.physical != nullptr;
@@ -109,7 +115,7 @@ json SceneState::describe(Entry& e) {
 
   ControlPanel panel = o.getControlPanel();
   json fields = json::array();
-  ControlProgram* program = o.getControlProgram();
+  ControlProgram* program = e.program;
   for (const ControlPanelField& f : panel.fields) {
     json jf = {{"name", f.name},       {"label", f.label},       {"kind", fieldKindName(f.kind)},
                {"size", f.size},       {"unit", f.unit},         {"min", f.min},
@@ -187,7 +193,12 @@ bool SceneState::refresh() {
     Entry& e = it->second;
     ++e.sightings;
     e.index = static_cast<int>(objects.size());
-    objects.push_back(describe(e));
+    if (e.described && retiring(e)) {
+      objects.push_back(e.description);  // as last described
+      return;
+    }
+    e.description = describe(e);
+    objects.push_back(e.description);
     e.described = true;
   });
   for (auto it = entries_.begin(); it != entries_.end();)
@@ -219,7 +230,7 @@ std::string SceneState::buildFrame() {
 
   ObjectManager().forEachObject([&](RoboticObject& o) {
     auto it = entries_.find(&o);
-    if (it == entries_.end() || !it->second.described || it->second.index < 0) return;
+    if (it == entries_.end() || !it->second.described || it->second.index < 0 || retiring(it->second)) return;
     Entry& e = it->second;
     StateSnapshot snap;
     const bool hasState = o.getStateSnapshot(snap);

@@ -14,6 +14,7 @@
 #include "rp/core/RoboticObject.hpp"
 
 namespace rp {
+class ControlProgram;
 class Manipulator;
 struct ManipulatorData;
 }  // namespace rp
@@ -49,11 +50,14 @@ class SceneState {
     bool described = false;
     PhysicalObject* physical = nullptr;
     Manipulator* manipulator = nullptr;
+    ControlProgram* program = nullptr;  // the object's control loop, if it has one
     std::vector<std::string> frames;
     std::unique_ptr<ManipulatorData> data;
     int index = -1;  // position in the scene's object array
+    nlohmann::json description;  // the last description
   };
   nlohmann::json describe(Entry& e);
+  static bool retiring(const Entry& e);
 
   std::map<RoboticObject*, Entry> entries_;
   std::string sceneMessage_;

@@ -18,9 +18,8 @@ describe('QMotor window on work_cell -qmotor', () => {
     await page.waitForSelector('.u-wrap canvas');
     assert.deepEqual(await page.evaluate(() => window.rp.series), ['q[0]', 'q[1]', 'q[2]', 'q[3]', 'q[4]', 'q[5]']);
     const n0 = await page.evaluate(() => window.rp.samples);
-    await sleep(1000);
+    await waitInPage(page, (n) => window.rp.samples > n + 30, n0);
     const got = await page.evaluate(() => ({ n: window.rp.samples, t: window.rp.data[0], q: window.rp.data[1] }));
-    assert.ok(got.n - n0 > 20, `${got.n - n0} samples in 1 s`);
     assert.ok(got.t[got.t.length - 1] > got.t[0], 'time does not advance');
     assert.ok(Math.max(...got.q) - Math.min(...got.q) > 1e-3, 'joint 1 does not move in the plot');
     // Add the torques: six more series.

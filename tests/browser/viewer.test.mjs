@@ -23,11 +23,10 @@ describe('Scene Viewer on work_cell', () => {
     const a = await canvasStats(ctx.page);
     assert.ok(a.foreground > a.total * 0.02, `only ${a.foreground} of ${a.total} pixels differ from the background`);
     const q0 = await ctx.page.evaluate(() => window.rp.frame.objects[0].values.slice(0, 6));
-    await sleep(1500);
+    // Wait until the arm has moved by 0.1 rad in some joint (it may be at one of its stops).
+    await waitInPage(ctx.page, (q) => window.rp.frame.objects[0].values.slice(0, 6).some((x, i) => Math.abs(x - q[i]) > 0.1), q0);
+    await sleep(200);  // a few frames drawn
     const b = await canvasStats(ctx.page);
-    const q1 = await ctx.page.evaluate(() => window.rp.frame.objects[0].values.slice(0, 6));
-    const moved = q0.some((q, i) => Math.abs(q - q1[i]) > 1e-3);
-    assert.ok(moved, `the arm did not move: ${q0} -> ${q1}`);
     assert.ok(pixelsChanged(a, b) > 50, `the picture did not change (${pixelsChanged(a, b)} pixels)`);
     if (shots) await ctx.page.screenshot({ path: join(shots, 'scene-viewer.png') });
   });
@@ -111,13 +110,11 @@ describe('Scene Viewer on work_cell', () => {
 
   it('two pages at once both receive state', async () => {
     const second = await openViewer(ctx.browser, ctx.url, { width: 600, height: 400 });
+    // Both keep receiving (no rate asserted: the machine may be loaded).
     const n1 = await ctx.page.evaluate(() => window.rp.frames);
     const m1 = await second.evaluate(() => window.rp.frames);
-    await sleep(1000);
-    const n2 = await ctx.page.evaluate(() => window.rp.frames);
-    const m2 = await second.evaluate(() => window.rp.frames);
-    assert.ok(n2 - n1 > 20, `first page got ${n2 - n1} frames in 1 s`);
-    assert.ok(m2 - m1 > 20, `second page got ${m2 - m1} frames in 1 s`);
+    await waitInPage(ctx.page, (n) => window.rp.frames > n + 30, n1);
+    await waitInPage(second, (m) => window.rp.frames > m + 30, m1);
     await second.close();
   });
 
@@ -158,8 +155,7 @@ describe('Scene Viewer on work_cell', () => {
     has(/binary messages are not accepted/);
     assert.equal(replies.state, 3, 'an oversize message must close the connection');
     const n1 = await ctx.page.evaluate(() => window.rp.frames);
-    await sleep(500);
-    assert.ok((await ctx.page.evaluate(() => window.rp.frames)) > n1, 'the server stopped sending after bad messages');
+    await waitInPage(ctx.page, (n) => window.rp.frames > n + 10, n1);  // still sending
   });
 
   it('refuses a wrong or missing token and a foreign Origin', async () => {
