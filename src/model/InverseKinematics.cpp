@@ -88,6 +88,8 @@ IkStatus inverseKinematics(const ManipulatorModel& model, ManipulatorData& data,
     bool solved = converged(e, options);
     if (!solved) internal::jacobianFromKinematics(model, data);
     double mu = 1.0;
+    // Abandoning a stagnating attempt pays only if another attempt follows.
+    const bool mayRestart = options.stallIterations > 0 && (timed || attempt + 1 < options.maxAttempts);
     double checkpointError = err;
     int checkpoint = 0;
     for (int it = 0; it < options.maxIterations && !solved; ++it) {
@@ -106,7 +108,7 @@ IkStatus inverseKinematics(const ManipulatorModel& model, ManipulatorData& data,
         mu = std::min(mu * 4.0, 1e6);
       }
       // Stagnation: the (squared) error must fall to a quarter within stallIterations.
-      if (options.stallIterations > 0 && it - checkpoint >= options.stallIterations) {
+      if (mayRestart && it - checkpoint >= options.stallIterations) {
         if (err > 0.25 * checkpointError) break;
         checkpoint = it;
         checkpointError = err;

@@ -28,7 +28,8 @@ struct IkOptions {
   /// limit, `maxAttempts` attempts.
   double timeBudget = 0;
   /// An attempt that has not reduced its error by half within this many iterations is abandoned
-  /// for a restart (stagnation, typically against a joint limit); 0: never.
+  /// for a restart (stagnation, typically against a joint limit); 0: never. The last attempt
+  /// (with `maxAttempts` = 1, the only one) always runs its `maxIterations`.
   int stallIterations = 12;
 };
 
