@@ -129,7 +129,9 @@ TEST(SceneViewer, PortFallbackAndErrors) {
   if (!ec) defaultTaken.listen();
   o.port = rp::kSceneViewerDefaultPort;
   v.start(o);
-  if (!ec) EXPECT_NE(v.getPort(), rp::kSceneViewerDefaultPort);  // else another program holds it
+  if (!ec) {  // (else another program holds it)
+    EXPECT_NE(v.getPort(), rp::kSceneViewerDefaultPort);
+  }
   EXPECT_GT(v.getPort(), 0);
   v.stop();
   o.port = 0;
