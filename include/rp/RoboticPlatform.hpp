@@ -12,3 +12,4 @@
 #include "rp/manipulator/Manipulators.hpp"
 #include "rp/io/Io.hpp"
 #include "rp/effector/Effector.hpp"
+#include "rp/gui/SceneViewer.hpp"

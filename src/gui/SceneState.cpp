@@ -144,7 +144,9 @@ json SceneState::describe(Entry& e) {
     Model3D m = e.physical->get3DModel();
     e.frames = m.frames;
     json shapes = json::array();
+    e.meshes.clear();
     for (const Shape& s : m.shapes) {
+      e.meshes.push_back(s.kind == ShapeKind::Mesh ? s.meshFile : std::string());
       shapes.push_back({{"kind", shapeKindName(s.kind)},
                         {"frame", s.frame},
                         {"pose", transformJson(s.pose)},
@@ -210,6 +212,12 @@ bool SceneState::refresh() {
   json msg = {{"type", "scene"}, {"protocol", kSceneViewerProtocolVersion}, {"version", version_}, {"objects", objects}};
   sceneMessage_ = msg.dump();
   return true;
+}
+
+std::string SceneState::meshFile(const std::string& name, std::size_t shape) const {
+  for (const auto& [object, e] : entries_)
+    if (e.described && e.name == name) return shape < e.meshes.size() ? e.meshes[shape] : std::string();
+  return {};
 }
 
 std::string SceneState::buildFrame() {

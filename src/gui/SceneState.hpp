@@ -42,6 +42,9 @@ class SceneState {
   // Builds one binary state frame of every described object that still exists.
   std::string buildFrame();
 
+  // The mesh file of shape `shape` of the described object `name` (empty if there is none).
+  std::string meshFile(const std::string& name, std::size_t shape) const;
+
  private:
   struct Entry {
     RoboticObject* object = nullptr;
@@ -55,6 +58,7 @@ class SceneState {
     std::unique_ptr<ManipulatorData> data;
     int index = -1;  // position in the scene's object array
     nlohmann::json description;  // the last description
+    std::vector<std::string> meshes;  // mesh file of each shape (empty for other shapes)
   };
   nlohmann::json describe(Entry& e);
   static bool retiring(const Entry& e);

@@ -312,6 +312,7 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
       json info = {{"protocol", kSceneViewerProtocolVersion}, {"tokenRequired", !impl_.token.empty()}};
       return respond(http::status::ok, "application/json", info.dump(), req);
     }
+    if (path == "/mesh") return serveMesh(target, req);
     const std::filesystem::path file = std::filesystem::path(impl_.options.webRoot) / path.substr(1);
     std::ifstream in(file, std::ios::binary);
     std::error_code ec;
@@ -322,6 +323,26 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
     std::ostringstream body;
     body << in.rdbuf();
     respond(http::status::ok, mimeType(path), body.str(), req);
+  }
+
+  // GET /mesh?object=NAME&shape=I[&token=T]: the mesh file that shape I of a live object's 3D model
+  // names, and nothing else (no path from the request reaches the file system).
+  void serveMesh(const std::string& target, const http::request<http::string_body>& req) {
+    if (!impl_.token.empty() && !constantTimeEqual(queryValue(target, "token"), impl_.token))
+      return respond(http::status::forbidden, "text/plain", "wrong or missing token\n", req);
+    const std::string object = queryValue(target, "object"), shape = queryValue(target, "shape");
+    std::size_t index = 0;
+    if (shape.empty() || shape.size() > 6 || shape.find_first_not_of("0123456789") != std::string::npos)
+      return respond(http::status::bad_request, "text/plain", "shape must be a number\n", req);
+    index = static_cast<std::size_t>(std::stoul(shape));
+    const std::string file = impl_.scene.meshFile(object, index);
+    std::error_code ec;
+    if (file.empty() || !std::filesystem::is_regular_file(file, ec) || std::filesystem::file_size(file, ec) > (64u << 20))
+      return respond(http::status::not_found, "text/plain", "no mesh file for that shape\n", req);
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream body;
+    body << in.rdbuf();
+    respond(http::status::ok, "application/octet-stream", body.str(), req);
   }
 
   void respond(http::status status, const std::string& type, std::string body,

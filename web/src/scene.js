@@ -3,6 +3,10 @@
 // gripper fingers that follow the gripper's state; OrbitControls for the mouse.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { STLLoader } from 'three/examples/jsm/loaders/STLLoader.js';
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { ColladaLoader } from 'three/examples/jsm/loaders/ColladaLoader.js';
+import { VRMLLoader } from 'three/examples/jsm/loaders/VRMLLoader.js';
 
 const unitCylinder = new THREE.CylinderGeometry(1, 1, 1, 20); // along y, height 1
 const unitBox = new THREE.BoxGeometry(1, 1, 1);
@@ -10,6 +14,30 @@ const unitSphere = new THREE.SphereGeometry(1, 20, 14);
 
 function colorOf(c) {
   return new THREE.Color(c[0], c[1], c[2]);
+}
+
+// The URL of shape `index` of object `name`'s mesh: served by the program (only files its objects'
+// models name), or the model's own http(s) URL.
+function meshUrl(name, index, file) {
+  if (/^https?:\/\//.test(file)) return file;
+  const token = new URLSearchParams(location.search).get('token');
+  return `mesh?object=${encodeURIComponent(name)}&shape=${index}${token ? `&token=${encodeURIComponent(token)}` : ''}`;
+}
+
+// Loads a mesh file (STL, glTF/GLB, Collada, VRML, by the file's extension) into `holder`.
+function loadMesh(holder, url, file, material, onDone) {
+  const ext = file.toLowerCase().split('.').pop();
+  const done = (object) => {
+    holder.add(object);
+    object.traverse((c) => (c.userData.object = holder.userData.object));
+    onDone(true);
+  };
+  const fail = () => onDone(false);
+  if (ext === 'stl') new STLLoader().load(url, (g) => done(new THREE.Mesh(g, material)), undefined, fail);
+  else if (ext === 'glb' || ext === 'gltf') new GLTFLoader().load(url, (g) => done(g.scene), undefined, fail);
+  else if (ext === 'dae') new ColladaLoader().load(url, (c) => done(c.scene), undefined, fail);
+  else if (ext === 'wrl') new VRMLLoader().load(url, (v) => done(v), undefined, fail);
+  else fail();
 }
 
 export class SceneView {
@@ -35,6 +63,7 @@ export class SceneView {
     this.scene.add(grid);
     this.scene.add(new THREE.AxesHelper(0.3));
     this.objects = new Map(); // name -> { root, frames, bones, fingers, desc, materials }
+    this.meshes = { loaded: 0, failed: 0 };
     this.raycaster = new THREE.Raycaster();
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
@@ -94,9 +123,19 @@ export class SceneView {
       return g;
     });
     const frameByName = new Map(frames.map((g) => [g.name, g]));
-    for (const s of desc.shapes || []) {
+    (desc.shapes || []).forEach((s, shapeIndex) => {
       let mesh;
-      if (s.kind === 'cylinder') {
+      if (s.kind === 'mesh' && s.mesh) {
+        // A box of the given size until the file is loaded, then the mesh scaled by size.
+        mesh = new THREE.Group();
+        mesh.scale.set(s.size[0], s.size[1], s.size[2]);
+        mesh.userData.object = desc.name;
+        const mat = material(s.color);
+        loadMesh(mesh, meshUrl(desc.name, shapeIndex, s.mesh), s.mesh, mat, (ok) => {
+          if (ok) this.meshes.loaded++;
+          else this.meshes.failed++;
+        });
+      } else if (s.kind === 'cylinder') {
         mesh = new THREE.Mesh(unitCylinder, material(s.color));
         mesh.scale.set(s.size[0], s.size[1], s.size[0]);
         mesh.rotation.x = Math.PI / 2; // the model's cylinders run along z
@@ -113,7 +152,7 @@ export class SceneView {
       holder.matrix.fromArray(s.pose);
       holder.add(mesh);
       (frameByName.get(s.frame) || frames[0]).add(holder);
-    }
+    });
     const o = { root, frames, desc, key, materials, bones: [], fingers: null };
     if (desc.kind === 'manipulator') {
       const linkMat = material([0.55, 0.6, 0.7, 1]);
