@@ -2,7 +2,7 @@
 // drive Debian's Chromium headless through playwright-core (from web/node_modules).
 import { spawn } from 'node:child_process';
 import { createRequire } from 'node:module';
-import { mkdtempSync } from 'node:fs';
+import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import http from 'node:http';
@@ -18,8 +18,9 @@ export const CHROMIUM = process.env.RP_CHROMIUM || '/usr/bin/chromium';
 
 // Starts `program args...`; resolves when it has printed the Scene Viewer URL.
 export function startProgram(program, args = [], { cwd } = {}) {
+  const workDir = cwd ? null : mkdtempSync(join(tmpdir(), 'rp-browser-'));
   const proc = spawn(join(BIN, program), args, {
-    cwd: cwd || mkdtempSync(join(tmpdir(), 'rp-browser-')),
+    cwd: cwd || workDir,
     stdio: ['ignore', 'pipe', 'pipe'],
   });
   let out = '';
@@ -55,6 +56,7 @@ export function startProgram(program, args = [], { cwd } = {}) {
       const timer = setTimeout(() => proc.kill('SIGKILL'), 10000);
       const r = await exited;
       clearTimeout(timer);
+      if (workDir) rmSync(workDir, { recursive: true, force: true });
       return r;
     },
   };
