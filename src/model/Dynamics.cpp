@@ -7,6 +7,12 @@
 // modified DH). The linear acceleration of a frame origin is carried outward through a point on
 // the joint axis, which is fixed in both links of a revolute joint: frame i-1's origin in standard
 // DH, frame i's in modified DH. A prismatic joint adds its sliding and Coriolis terms.
+//
+// The inverse dynamics and the Coriolis torques use that recursion. The gravity torque, the mass
+// matrix and the forward dynamics (the simulation's step) work in world coordinates after one
+// forward kinematics instead: the gravity torque from sums of link mass moments, the mass matrix by
+// composite rigid bodies, the velocity products by a Newton-Euler pass on spatial vectors. The
+// tests compare each with the recursion above, with KDL and with finite differences.
 #include "rp/model/Dynamics.hpp"
 
 #include <cmath>
@@ -117,8 +123,44 @@ const JointVector& inverseDynamics(const ManipulatorModel& model, ManipulatorDat
   return data.tau;
 }
 
+namespace {
+
+// The gravity torque from the link frames of the last forward kinematics and sums of link mass
+// moments (no Newton-Euler recursion): with the potential energy U = -sum_k m_k g . c_k, a revolute
+// joint i turning about the line through o_i along z_i moves the centres of mass of links i..n at
+// dc_k/dq_i = z_i x (c_k - o_i), so
+//   g_i = dU/dq_i = -z_i . ((H_i - M_i o_i) x g),  H_i = sum_{k>=i} m_k c_k,  M_i = sum_{k>=i} m_k,
+// and a prismatic joint along z_i gives g_i = -M_i z_i . g.
+// forwardDynamics() takes its gravity part from this same (never inlined) function after the same
+// forwardKinematics() call, so that with tau = gravityTorque(q) at rest it subtracts bit-identical
+// numbers and the accelerations are exactly zero (simulations with discontinuous Coulomb friction
+// rely on that; see forwardDynamics()).
+[[gnu::noinline]] void gravityFromKinematics(const ManipulatorModel& model, const ManipulatorData& data,
+                                             JointVector& tau) {
+  const V3 g = model.getGravity();
+  double mass = 0;
+  V3 moment = V3::Zero();
+  for (int i = data.n - 1; i >= 0; --i) {
+    const auto k = static_cast<std::size_t>(i);
+    const LinkParameters& l = model.getLink(i);
+    const Transform& T = data.linkTransforms[k];
+    moment += l.mass * (T.topLeftCorner<3, 3>() * V3(l.com) + V3(T.topRightCorner<3, 1>()));
+    mass += l.mass;
+    const Transform& axis = internal::axisFrame(model, data, i);
+    const V3 z = axis.block<3, 1>(0, 2);
+    if (l.type == JointType::Prismatic) {
+      tau(i) = -mass * z.dot(g);
+    } else {
+      tau(i) = -z.dot((moment - mass * V3(axis.topRightCorner<3, 1>())).cross(g));
+    }
+  }
+}
+
+}  // namespace
+
 void gravityTorque(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q, JointVector& tau) {
-  rnea(model, data, q, data.zero, data.zero, true, false, false, nullptr, tau);
+  forwardKinematics(model, data, q);
+  gravityFromKinematics(model, data, tau);
 }
 
 void frictionTorque(const ManipulatorModel& model, const JointVector& qd, JointVector& tau) {
@@ -143,30 +185,15 @@ Eigen::Matrix3d skew(const V3& v) {
   return m;
 }
 
-// Forward kinematics from the link transforms A_i = (data.R, data.pstar) of the last Newton-Euler
-// pass: data.linkTransforms and data.endEffector, as forwardKinematics() would give them.
-void composeLinkTransforms(const ManipulatorModel& model, ManipulatorData& data) {
-  const Transform* previous = &model.getBaseTransform();
-  for (int i = 0; i < data.n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    Transform& T = data.linkTransforms[k];
-    T.topLeftCorner<3, 3>().noalias() = previous->topLeftCorner<3, 3>() * data.R[k];
-    T.topRightCorner<3, 1>() = previous->topLeftCorner<3, 3>() * data.pstar[k] + previous->topRightCorner<3, 1>();
-    T.row(3) << 0, 0, 0, 1;
-    previous = &T;
-  }
-  const Transform& tool = model.getToolTransform();
-  data.endEffector.topRows<3>().noalias() = previous->topLeftCorner<3, 3>() * tool.topRows<3>();
-  data.endEffector.topRightCorner<3, 1>() += previous->topRightCorner<3, 1>();
-  data.endEffector.row(3) << 0, 0, 0, 1;
-}
+using M3 = Eigen::Matrix3d;
 
-// After forwardKinematics(): each joint's motion subspace S_i and each link's rigid spatial
-// inertia, as spatial vectors (angular; linear) in world coordinates at the world origin.
-// S_i = (z; o x z) for a rotation about the line through o along z, (0; z) for a translation.
-// The inertia is [Ic + m (|c|^2 1 - c c^T), h^; h^T, m 1] with c the centre of mass, h = m c and
-// Ic the inertia about c.
-void worldSubspacesAndInertias(const ManipulatorModel& model, ManipulatorData& data) {
+// After forwardKinematics(), spatial vectors (angular; linear) in world coordinates at the world
+// origin: each joint's motion subspace S_i = (z; o x z) for a rotation about the line through o
+// along z, (0; z) for a translation; and each link's inertia in the compact form its spatial
+// inertia [Io, h^; h^T, m 1] is made of: the mass moment h = m c (c the centre of mass) and the
+// rotational inertia about the origin Io = R Ic R^T + m (|c|^2 1 - c c^T). With it, I (w; v) = (Io w + h x v; m v - h x w)
+// costs two 3x3 products instead of a 6x6 one, and inertias add as (m, h, Io).
+void worldLinkInertias(const ManipulatorModel& model, ManipulatorData& data) {
   for (int i = 0; i < data.n; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const LinkParameters& l = model.getLink(i);
@@ -179,33 +206,122 @@ void worldSubspacesAndInertias(const ManipulatorModel& model, ManipulatorData& d
       S << z, V3(axis.topRightCorner<3, 1>()).cross(z);
     }
     const Transform& T = data.linkTransforms[k];
-    const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+    const M3 R = T.topLeftCorner<3, 3>();
     const V3 c = R * V3(l.com) + V3(T.topRightCorner<3, 1>());
-    const Eigen::Matrix3d hx = skew(l.mass * c);
-    M6& I = data.articulatedInertia[k];
-    I.topLeftCorner<3, 3>().noalias() = R * Eigen::Matrix3d(l.inertia) * R.transpose();
-    I.topLeftCorner<3, 3>().noalias() -= hx * skew(c);
-    I.topRightCorner<3, 3>() = hx;
-    I.bottomLeftCorner<3, 3>() = hx.transpose();
-    I.bottomRightCorner<3, 3>() = l.mass * Eigen::Matrix3d::Identity();
+    data.massMoment[k] = l.mass * c;
+    M3 RI;
+    RI.noalias() = R * M3(l.inertia);
+    M3& Io = data.originInertia[k];
+    Io.noalias() = RI * R.transpose();
+    Io.diagonal().array() += l.mass * c.squaredNorm();
+    Io.noalias() -= (l.mass * c) * c.transpose();
   }
 }
 
-// The composite-rigid-body algorithm on the world-frame quantities above: with Ic_j the summed
-// inertia of links j..n, M_ij = S_i . (Ic_j S_j) for i <= j (the inertias stay unchanged).
+// The full spatial inertias [Io, h^; h^T, m 1] of worldLinkInertias() (for the articulated-body
+// algorithm, whose articulated inertias lose that structure).
+void worldSpatialInertias(const ManipulatorModel& model, ManipulatorData& data) {
+  worldLinkInertias(model, data);
+  for (int i = 0; i < data.n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const M3 hx = skew(data.massMoment[k]);
+    M6& I = data.articulatedInertia[k];
+    I.topLeftCorner<3, 3>() = data.originInertia[k];
+    I.topRightCorner<3, 3>() = hx;
+    I.bottomLeftCorner<3, 3>() = hx.transpose();
+    I.bottomRightCorner<3, 3>() = model.getLink(i).mass * M3::Identity();
+  }
+}
+
+// The composite-rigid-body algorithm on those quantities: with (m, h, Io) summed over links j..n
+// (the inertia I^c_j), F_j = I^c_j S_j and M_ij = S_i . F_j for i <= j.
 void compositeRigidBody(const ManipulatorModel& model, ManipulatorData& data, bool motorInertia) {
-  const int n = data.n;
-  M6 Ic = M6::Zero();
-  for (int j = n - 1; j >= 0; --j) {
+  double m = 0;
+  V3 h = V3::Zero();
+  M3 Io = M3::Zero();
+  for (int j = data.n - 1; j >= 0; --j) {
     const auto k = static_cast<std::size_t>(j);
-    Ic += data.articulatedInertia[k];
-    const V6 F = Ic * data.motionSubspace[k];
+    m += model.getLink(j).mass;
+    h += data.massMoment[k];
+    Io += data.originInertia[k];
+    const V6& S = data.motionSubspace[k];
+    const V3 sw = S.head<3>(), sv = S.tail<3>();
+    const V3 Fn = Io * sw + h.cross(sv), Ff = m * sv - h.cross(sw);
     for (int i = 0; i <= j; ++i) {
-      const double m = data.motionSubspace[static_cast<std::size_t>(i)].dot(F);
-      data.massMatrix(i, j) = m;
-      data.massMatrix(j, i) = m;
+      const V6& Si = data.motionSubspace[static_cast<std::size_t>(i)];
+      const double Mij = Si.head<3>().dot(Fn) + Si.tail<3>().dot(Ff);
+      data.massMatrix(i, j) = Mij;
+      data.massMatrix(j, i) = Mij;
     }
     if (motorInertia) data.massMatrix(j, j) += model.getArmatureInertia()(j);
+  }
+}
+
+// The wrench the last link exerts on its environment (at link frame n's origin, in its
+// coordinates) is an external force of minus it on that link: it adds to the link's bias force
+// (world coordinates, world origin) like an inertial force.
+void addTipWrench(ManipulatorData& data, const Vector<6>& tipWrench) {
+  const Transform& T = data.linkTransforms[static_cast<std::size_t>(data.n - 1)];
+  const V3 f = T.topLeftCorner<3, 3>() * tipWrench.head<3>();
+  V6& F = data.biasForce[static_cast<std::size_t>(data.n - 1)];
+  F.head<3>() += T.topLeftCorner<3, 3>() * tipWrench.tail<3>() + V3(T.topRightCorner<3, 1>()).cross(f);
+  F.tail<3>() += f;
+}
+
+// The velocity-product torques C(q, qd) qd plus the torques of the tip wrench, by Newton-Euler on
+// the world-frame quantities of worldLinkInertias() (no gravity: that part comes from
+// gravityFromKinematics()). Outward: spatial velocities v_i = v_{i-1} + S_i qd_i and accelerations
+// a_i = a_{i-1} + v_i x S_i qd_i; each link's force I_i a_i + v_i x* I_i v_i; inward: the summed
+// forces F_i and tau_i = S_i . F_i. At qd = 0 with no wrench every term is exactly zero.
+void velocityProductTorques(const ManipulatorModel& model, ManipulatorData& data, const JointVector& qd,
+                            const Vector<6>& tipWrench, JointVector& tau) {
+  const int n = data.n;
+  V3 w = V3::Zero(), v = V3::Zero(), aw = V3::Zero(), av = V3::Zero();
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const V6& S = data.motionSubspace[k];
+    const V3 jw = S.head<3>() * qd(i), jv = S.tail<3>() * qd(i);
+    w += jw;
+    v += jv;
+    aw += w.cross(jw);
+    av += w.cross(jv) + v.cross(jw);
+    const double m = model.getLink(i).mass;
+    const V3& h = data.massMoment[k];
+    const M3& Io = data.originInertia[k];
+    const V3 nI = Io * w + h.cross(v), fI = m * v - h.cross(w);
+    data.biasForce[k] << Io * aw + h.cross(av) + w.cross(nI) + v.cross(fI), m * av - h.cross(aw) + w.cross(fI);
+  }
+  addTipWrench(data, tipWrench);
+  V6 F = V6::Zero();
+  for (int i = n - 1; i >= 0; --i) {
+    const auto k = static_cast<std::size_t>(i);
+    F += data.biasForce[k];
+    tau(i) = data.motionSubspace[k].dot(F);
+  }
+}
+
+// M = L D L^T in place in data.ldl (M is symmetric positive definite: no pivoting), then
+// x <- M^-1 x by forward substitution, division by D and back substitution. O(n^3 / 6).
+void ldlSolveInPlace(ManipulatorData& data, JointVector& x) {
+  const int n = data.n;
+  JointMatrix& L = data.ldl;
+  const JointMatrix& M = data.massMatrix;
+  for (int j = 0; j < n; ++j) {
+    double d = M(j, j);
+    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k) * L(k, k);
+    L(j, j) = d;
+    for (int i = j + 1; i < n; ++i) {
+      double s = M(i, j);
+      for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k) * L(k, k);
+      L(i, j) = s / d;
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < i; ++k) x(i) -= L(i, k) * x(k);
+  }
+  for (int i = 0; i < n; ++i) x(i) /= L(i, i);
+  for (int i = n - 1; i >= 0; --i) {
+    for (int k = i + 1; k < n; ++k) x(i) -= L(k, i) * x(k);
   }
 }
 
@@ -214,25 +330,32 @@ void compositeRigidBody(const ManipulatorModel& model, ManipulatorData& data, bo
 const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                               bool motorInertia) {
   forwardKinematics(model, data, q);
-  worldSubspacesAndInertias(model, data);
+  worldLinkInertias(model, data);
   compositeRigidBody(model, data, motorInertia);
   return data.massMatrix;
 }
 
 const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                                    const JointVector& qd, const JointVector& tau, const DynamicsOptions& options) {
-  // qdd holds tau - h until it is solved in place (massMatrix() uses scratchTau).
-  rnea(model, data, q, qd, data.zero, options.gravity, false, options.friction, &options.tipWrench, data.qdd);
-  data.qdd = tau - data.qdd;
-  // The mass matrix from the link transforms Newton-Euler left in data.R / data.pstar (no trigonometry).
-  composeLinkTransforms(model, data);
-  worldSubspacesAndInertias(model, data);
+  // h = g(q) + C(q, qd) qd [+ tip wrench] [+ friction], summed in that order.
+  forwardKinematics(model, data, q);
+  if (options.gravity) {
+    gravityFromKinematics(model, data, data.bias);
+  } else {
+    data.bias.setZero();
+  }
+  worldLinkInertias(model, data);
+  velocityProductTorques(model, data, qd, options.tipWrench, data.scratchTau);
+  for (int i = 0; i < data.n; ++i) {
+    double h = data.bias(i) + data.scratchTau(i);
+    if (options.friction) h += jointFriction(model.getLink(i), qd(i));
+    data.bias(i) = h;
+    data.qdd(i) = tau(i) - h;
+  }
   compositeRigidBody(model, data, options.motorInertia);
-  data.ldlt.compute(data.massMatrix);
-  data.ldlt.solveInPlace(data.qdd);
+  ldlSolveInPlace(data, data.qdd);
   return data.qdd;
 }
-
 
 const JointVector& forwardDynamicsArticulatedBody(const ManipulatorModel& model, ManipulatorData& data,
                                                   const JointVector& q, const JointVector& qd, const JointVector& tau,
@@ -242,8 +365,7 @@ const JointVector& forwardDynamicsArticulatedBody(const ManipulatorModel& model,
   // inertias and bias forces add directly into the parent and accelerations carry over as they are.
   const int n = data.n;
   forwardKinematics(model, data, q);
-
-  worldSubspacesAndInertias(model, data);
+  worldSpatialInertias(model, data);
 
   // Pass 1, outward: velocities, velocity-product accelerations c_i = v_i x S_i qd_i and bias
   // forces v_i x* (I_i v_i).
@@ -261,15 +383,7 @@ const JointVector& forwardDynamicsArticulatedBody(const ManipulatorModel& model,
     const V3 fI = I.bottomLeftCorner<3, 3>() * w + I.bottomRightCorner<3, 3>() * v;
     data.biasForce[k] << w.cross(nI) + v.cross(fI), w.cross(fI);
   }
-  // The tip wrench the last link exerts on its environment (at link frame n's origin, in its
-  // coordinates) is an external force of minus it: it adds to that link's bias force.
-  {
-    const Transform& T = data.linkTransforms[static_cast<std::size_t>(n - 1)];
-    const V3 f = T.topLeftCorner<3, 3>() * options.tipWrench.head<3>();
-    V6& pA = data.biasForce[static_cast<std::size_t>(n - 1)];
-    pA.head<3>() += T.topLeftCorner<3, 3>() * options.tipWrench.tail<3>() + V3(T.topRightCorner<3, 1>()).cross(f);
-    pA.tail<3>() += f;
-  }
+  addTipWrench(data, options.tipWrench);
 
   // Pass 2, inward: articulated inertias and bias forces, added straight into the parent's.
   for (int i = n - 1; i >= 0; --i) {

@@ -61,8 +61,9 @@ ManipulatorData::ManipulatorData(const ManipulatorModel& model) : n(model.getNum
   linkTransforms.fill(Transform::unit());
   endEffector = Transform::unit();
   jacobian = Jacobian(6, n);
-  for (JointVector* v : {&tau, &qdd, &scratchTau, &zero, &unitColumn, &abaD, &abaU}) v->setZero(n);
+  for (JointVector* v : {&tau, &qdd, &scratchTau, &zero, &unitColumn, &abaD, &abaU, &bias}) v->setZero(n);
   massMatrix.setZero(n, n);
+  ldl.setZero(n, n);
 }
 
 }  // namespace rp

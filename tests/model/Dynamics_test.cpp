@@ -1,7 +1,8 @@
 // Internal consistency of the dynamics on seeded random states of every built-in robot, of the
 // modified-DH Puma 560 and of a URDF arm with prismatic joints (standard and modified DH):
-// RNEA = M qdd + C + g, forward dynamics inverts inverse dynamics, the Jacobian matches finite
-// differences of forward kinematics, and J^T F matches the Newton-Euler tip wrench.
+// RNEA = M qdd + C + g, forward dynamics inverts inverse dynamics (and is exactly zero at the
+// gravity equilibrium), the gravity torque is the gradient of the potential energy, the Jacobian
+// matches finite differences of forward kinematics, and J^T F matches the Newton-Euler tip wrench.
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
@@ -29,6 +30,17 @@ std::vector<std::unique_ptr<ManipulatorModel>> robots() {
   o.requireDynamics = true;
   r.push_back(loadUrdf(std::string(RP_TEST_DATA_DIR) + "/prismatic_arm.urdf", o));
   r.push_back(test::toModifiedDh(*r.back()));
+  // The WAM 7 on a tilted, shifted base with gravity off the vertical: the world-frame algorithms
+  // (gravity from mass moments, forward dynamics) against the Newton-Euler one, which works in
+  // link coordinates from the base's rotation.
+  const WAM7Model wam;
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < wam.getNumberOfJoints(); ++i) links.push_back(wam.getLink(i));
+  Vector<3> g;
+  g << 1.5, -2.0, -9.5;
+  r.push_back(std::make_unique<ManipulatorModel>("wam7_tilted", links,
+                                                 translation(0.3, -0.2, 0.5) * rpyToTransform(0.4, -0.7, 1.1),
+                                                 wam.getToolTransform(), g));
   return r;
 }
 
@@ -79,6 +91,83 @@ TEST(Dynamics, ForwardDynamicsInvertsInverseDynamics) {
       // The articulated-body algorithm (a second algorithm) agrees.
       const JointVector viaM = forwardDynamicsArticulatedBody(*robot, data, q, qd, tau, opt);
       for (int i = 0; i < robot->getNumberOfJoints(); ++i) EXPECT_NEAR(viaM(i), qdd(i), 1e-8) << robot->getName();
+    }
+  }
+}
+
+TEST(Dynamics, GravityTorqueIsTheGradientOfThePotentialEnergy) {
+  // A third reference for gravityTorque(): central differences of U(q) = -sum_k m_k g . c_k(q).
+  std::mt19937_64 rng(5);
+  const double h = 1e-6;
+  for (auto& robot : robots()) {
+    ManipulatorData data(*robot), fk(*robot);
+    const int n = robot->getNumberOfJoints();
+    const Eigen::Vector3d g = robot->getGravity();
+    const auto energy = [&](const JointVector& q) {
+      forwardKinematics(*robot, fk, q);
+      double U = 0;
+      for (int k = 0; k < n; ++k) {
+        const Transform& T = fk.linkTransforms[static_cast<std::size_t>(k)];
+        const LinkParameters& l = robot->getLink(k);
+        const Eigen::Vector3d c = T.topLeftCorner<3, 3>() * Eigen::Vector3d(l.com) + T.topRightCorner<3, 1>();
+        U -= l.mass * g.dot(c);
+      }
+      return U;
+    };
+    for (int trial = 0; trial < 50; ++trial) {
+      const JointVector q = randomJoints(*robot, rng);
+      JointVector tau(n);
+      gravityTorque(*robot, data, q, tau);
+      for (int j = 0; j < n; ++j) {
+        JointVector qp = q, qm = q;
+        qp(j) += h;
+        qm(j) -= h;
+        EXPECT_NEAR(tau(j), (energy(qp) - energy(qm)) / (2 * h), 1e-6 * (1 + std::abs(tau(j)))) << robot->getName();
+      }
+    }
+  }
+}
+
+TEST(Dynamics, ForwardDynamicsIsExactlyZeroAtTheGravityEquilibrium) {
+  // Holding torque = gravityTorque() at rest: forwardDynamics() subtracts the very same numbers
+  // (its gravity part is the same routine on the same forward kinematics), so the accelerations
+  // are exactly zero, with and without motor inertia and friction. The simulation relies on it.
+  std::mt19937_64 rng(6);
+  for (auto& robot : robots()) {
+    ManipulatorData control(*robot), sim(*robot);
+    const int n = robot->getNumberOfJoints();
+    for (int trial = 0; trial < 100; ++trial) {
+      const JointVector q = randomJoints(*robot, rng), rest(n);
+      JointVector g(n);
+      gravityTorque(*robot, control, q, g);
+      DynamicsOptions opt;
+      opt.motorInertia = trial % 2 == 0;
+      opt.friction = trial % 3 == 0;
+      const JointVector& qdd = forwardDynamics(*robot, sim, q, rest, g, opt);
+      for (int i = 0; i < n; ++i) EXPECT_EQ(qdd(i), 0.0) << robot->getName() << " joint " << i + 1;
+    }
+  }
+}
+
+TEST(Dynamics, ForwardDynamicsLeavesTheMassMatrixAndTheLinkFrames) {
+  // What forwardDynamics() documents it leaves in the data, against massMatrix() and
+  // forwardKinematics() run on their own.
+  std::mt19937_64 rng(7);
+  for (auto& robot : robots()) {
+    ManipulatorData data(*robot), ref(*robot);
+    const int n = robot->getNumberOfJoints();
+    for (int trial = 0; trial < 20; ++trial) {
+      const JointVector q = randomJoints(*robot, rng), qd = randomJoints(*robot, rng), tau = randomJoints(*robot, rng);
+      DynamicsOptions opt;
+      opt.motorInertia = trial % 2 == 0;
+      forwardDynamics(*robot, data, q, qd, tau, opt);
+      const JointMatrix M = massMatrix(*robot, ref, q, opt.motorInertia);
+      EXPECT_LT((data.massMatrix - M).cwiseAbs().maxCoeff(), 1e-12 * (1 + M.cwiseAbs().maxCoeff())) << robot->getName();
+      for (int k = 0; k < n; ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        EXPECT_LT((data.linkTransforms[i] - ref.linkTransforms[i]).cwiseAbs().maxCoeff(), 1e-15) << robot->getName();
+      }
+      EXPECT_LT((data.endEffector - ref.endEffector).cwiseAbs().maxCoeff(), 1e-15) << robot->getName();
     }
   }
 }

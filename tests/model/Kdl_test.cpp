@@ -55,7 +55,7 @@ TEST_P(KdlComparison, AgreesOnRandomConfigurations) {
   KDL::ChainFdSolver_RNE fdKdl(chain, KDL::Vector(0, 0, -9.81));
   std::mt19937_64 rng(2024);
   std::uniform_real_distribution<double> u(-1, 1);
-  double worstFk = 0, worstJ = 0, worstTau = 0, worstM = 0, worstFd = 0;
+  double worstFk = 0, worstJ = 0, worstTau = 0, worstM = 0, worstFd = 0, worstG = 0, worstC = 0;
   for (int trial = 0; trial < 1000; ++trial) {
     JointVector q(n), qd(n), qdd(n);
     for (int i = 0; i < n; ++i) {
@@ -96,6 +96,18 @@ TEST_P(KdlComparison, AgreesOnRandomConfigurations) {
     for (int r = 0; r < n; ++r)
       for (int c = 0; c < n; ++c) worstM = std::max(worstM, std::abs(M(r, c) - km(static_cast<unsigned>(r), static_cast<unsigned>(c))));
 
+    // Gravity torque (ours: forward kinematics and link mass moments) and Coriolis torques.
+    KDL::JntArray kg(static_cast<unsigned>(n)), kc(static_cast<unsigned>(n));
+    ASSERT_GE(dyn.JntToGravity(kq, kg), 0);
+    ASSERT_GE(dyn.JntToCoriolis(kq, kqd, kc), 0);
+    JointVector g(n), c(n);
+    gravityTorque(*model, data, q, g);
+    coriolisTorque(*model, data, q, qd, c);
+    for (int i = 0; i < n; ++i) {
+      worstG = std::max(worstG, std::abs(g(i) - kg(static_cast<unsigned>(i))));
+      worstC = std::max(worstC, std::abs(c(i) - kc(static_cast<unsigned>(i))));
+    }
+
     // Forward dynamics of the torques above (both of our algorithms), relative to the size of qdd.
     KDL::JntArray kqddBack(static_cast<unsigned>(n));
     ASSERT_GE(fdKdl.CartToJnt(kq, kqd, ktau, noWrench, kqddBack), 0);
@@ -112,6 +124,8 @@ TEST_P(KdlComparison, AgreesOnRandomConfigurations) {
   EXPECT_LT(worstJ, 1e-9);
   EXPECT_LT(worstTau, 1e-9);
   EXPECT_LT(worstM, 1e-9);
+  EXPECT_LT(worstG, 1e-9);
+  EXPECT_LT(worstC, 1e-9);
   RecordProperty("worst_fk", std::to_string(worstFk));
   RecordProperty("worst_tau", std::to_string(worstTau));
 }

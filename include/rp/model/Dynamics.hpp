@@ -31,9 +31,13 @@ const JointVector& inverseDynamics(const ManipulatorModel& model, ManipulatorDat
                                    const JointVector& qd, const JointVector& qdd,
                                    const DynamicsOptions& options = DynamicsOptions());
 
-/// The gravity torque \f$g(q)\f$ that holds the arm at rest in `q`.
+/// The gravity torque \f$g(q)\f$ that holds the arm at rest in `q`, from forward kinematics and
+/// sums of link mass moments: \f$g_i = -z_i \cdot ((H_i - M_i o_i) \times g)\f$ for a revolute
+/// joint about the line through \f$o_i\f$ along \f$z_i\f$, \f$g_i = -M_i z_i \cdot g\f$ for a
+/// prismatic one, with \f$M_i\f$ and \f$H_i\f$ the summed masses and mass moments
+/// \f$m_k c_k\f$ of links i..n (the gradient of the potential energy; no Newton-Euler pass).
 /// @param[in]  model  the manipulator
-/// @param[out] data   scratch
+/// @param[out] data   receives the forward kinematics of `q` (`linkTransforms`, `endEffector`)
 /// @param[in]  q      joint angles (n x 1) [rad]
 /// @param[out] tau    gravity torques (n x 1) [N m]
 /// Real-time safe: yes.
@@ -72,14 +76,17 @@ const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& da
                               bool motorInertia = false);
 
 /// Forward dynamics: the accelerations \f$\ddot q = M^{-1}(\tau - h(q, \dot q))\f$ that the
-/// torques `tau` produce, with \f$h\f$ the Newton-Euler torques at \f$\ddot q = 0\f$ and the
-/// effects in `options` (with motorInertia, \f$M\f$ includes \f$G^2 J_m\f$): \f$h\f$ by
-/// Newton-Euler, \f$M\f$ by massMatrix() and an LDL^T solve. At an equilibrium (`tau` equal to
-/// the Newton-Euler torques at rest) the accelerations are exactly zero, which simulations with
-/// discontinuous Coulomb friction rely on; forwardDynamicsArticulatedBody() is faster but leaves
+/// torques `tau` produce, with \f$h = g(q) + C(q, \dot q)\dot q\f$ plus the effects in `options`
+/// (with motorInertia, \f$M\f$ includes \f$G^2 J_m\f$). All in world coordinates after one
+/// forward kinematics: \f$g\f$ by the same routine as gravityTorque(), \f$C \dot q\f$ by a
+/// Newton-Euler pass on spatial vectors, \f$M\f$ by the composite-rigid-body algorithm as in
+/// massMatrix(), and an unpivoted LDL^T solve (\f$M\f$ is positive definite). At an equilibrium
+/// (`tau` equal to gravityTorque() of `q`, \f$\dot q = 0\f$) the accelerations are exactly
+/// zero, since the same numbers are subtracted; simulations with discontinuous Coulomb friction
+/// rely on that. forwardDynamicsArticulatedBody() computes \f$g\f$ differently and leaves
 /// rounding residues there.
 /// @param[in]  model    the manipulator
-/// @param[out] data     receives `qdd` and `massMatrix`
+/// @param[out] data     receives `qdd`, `massMatrix` and the forward kinematics of `q`
 /// @param[in]  q        joint positions (n x 1) [rad or m]
 /// @param[in]  qd       joint velocities (n x 1) [rad/s or m/s]
 /// @param[in]  tau      applied joint torques (n x 1) [N m or N]

@@ -44,7 +44,13 @@ struct ManipulatorData {
   std::array<Eigen::Matrix<double, 6, 6>, kMaxJoints> articulatedInertia;
   std::array<Eigen::Matrix<double, 6, 1>, kMaxJoints> biasForce, motionSubspace, biasAcceleration, inertiaTimesS;
   JointVector abaD, abaU;
-  Eigen::LDLT<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJoints, kMaxJoints>> ldlt;
+  // Scratch of forwardDynamics() and massMatrix(), per link, in world coordinates at the world
+  // origin: the mass moment m c and the rotational inertia about the origin (the spatial forces
+  // of the velocity products go into biasForce).
+  std::array<Vector<3>, kMaxJoints> massMoment;
+  std::array<Matrix<3, 3>, kMaxJoints> originInertia;
+  JointVector bias;  // h(q, qd) of the last forwardDynamics()
+  JointMatrix ldl;   // massMatrix = L D L^T: L strictly below the diagonal (unit diagonal), D on it
   /// @endcond
 };
 
