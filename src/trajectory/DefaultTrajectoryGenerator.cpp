@@ -1,6 +1,7 @@
 // The default trajectory generator's non-inline parts (rp/trajectory/DefaultTrajectoryGenerator.hpp).
 #include "rp/trajectory/DefaultTrajectoryGenerator.hpp"
 
+#include "CartesianPath.hpp"
 #include "rp/core/TypeDatabase.hpp"
 #include "rp/manipulator/Manipulator.hpp"
 #include "rp/model/InverseKinematics.hpp"
@@ -57,6 +58,17 @@ JointVector DefaultTrajectoryGenerator<N>::solvePose(const Transform& pose) {
                                 ") m within its joint limits");
   }
   return q;
+}
+
+template <int N>
+void DefaultTrajectoryGenerator<N>::queuePose(const Transform& pose) {
+  Manipulator& m = getPlanningManipulator();
+  const ManipulatorModel& model = m.getModel();
+  if (model.getNumberOfJoints() >= 6 && !internal::isSingular(model, getLastTarget())) {
+    queueCartesianMotion(pose);
+  } else {
+    queueJointMotion(solvePose(pose));
+  }
 }
 
 template class DefaultTrajectoryGenerator<Dynamic>;

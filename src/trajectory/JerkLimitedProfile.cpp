@@ -92,4 +92,28 @@ ProfileState JerkLimitedProfile::evaluate(double t) const {
   return s;
 }
 
+double JerkLimitedProfile::timeAtPosition(double position) const {
+  if (distance_ == 0 || position <= 0) return 0;
+  if (position >= distance_) return getDuration();
+  double lo = 0, hi = getDuration();
+  for (int i = 0; i < 200 && hi - lo > 1e-12; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (evaluate(mid).position < position) lo = mid;
+    else hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+int JerkLimitedProfile::getBreakpoints(double times[6]) const {
+  if (distance_ == 0) return 0;
+  const double T = getDuration();
+  const double all[6] = {tj_, ta_ - tj_, ta_, ta_ + tv_, T - ta_ + tj_, T - tj_};
+  int count = 0;
+  double last = 0;
+  for (double t : all) {
+    if (t > last && t < T) times[count++] = last = t;
+  }
+  return count;
+}
+
 }  // namespace rp

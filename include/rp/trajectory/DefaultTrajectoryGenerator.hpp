@@ -17,12 +17,18 @@ namespace rp {
 /// Queues motions to joint targets (move(), in degrees as the paper's Figure 23 writes them) and
 /// to end-effector poses (moveTo(), a Transform in metres as in Figure 21).
 ///
-/// Every motion is a synchronised straight line in joint space: all joints start and finish
-/// together, following one time-optimal jerk-limited profile under the tightest of the joints'
-/// velocity, acceleration and jerk limits (the model's). moveTo() solves the inverse kinematics
-/// from the previous target, which keeps the arm on that target's configuration (IK branch).
-/// A target outside the joint limits, or a pose the arm cannot reach, is refused with
-/// std::invalid_argument when it is queued, before the arm moves.
+/// move() is a synchronised straight line in joint space: all joints start and finish together,
+/// following one time-optimal jerk-limited profile under the tightest of the joints' velocity,
+/// acceleration and jerk limits (the model's, or setJointLimits()). moveTo() is a straight line
+/// of the end-effector with the shortest-arc rotation, its joints found by inverse kinematics that
+/// follows the arm's configuration (IK branch) from the previous target. Arms with fewer than six
+/// joints, which cannot follow an arbitrary line, and arms that start from a singular
+/// configuration (such as the Puma's ready pose, arm straight up and wrist stretched), from which
+/// no straight line is defined, move there in joint space instead (inverse kinematics on the
+/// previous target's configuration). Motions blend at via points when a blend radius is set
+/// (see QueueTrajectoryGenerator). A target outside the joint limits, or a pose the arm cannot
+/// reach along the line, is refused with std::invalid_argument when it is queued, before the arm
+/// moves.
 ///
 /// Use it as `DefaultTrajectoryGenerator<6> tragen;` (Figure 21: checked against a 6-joint
 /// manipulator when connected) or `DefaultTrajectoryGenerator tragen;` (Figure 23: any number of
@@ -62,13 +68,19 @@ class DefaultTrajectoryGenerator : public QueueTrajectoryGenerator {
   /// Queues a motion to the joint angles `target` [rad].
   /// @throws std::invalid_argument on a wrong count or a target outside the joint limits
   void moveRadians(const JointVector& target) { queueJointMotion(target); }
-  /// Queues a motion that brings the end-effector to `pose` (world frame, metres).
+  /// Queues a straight-line motion that brings the end-effector to `pose` (world frame, metres);
+  /// see the class description.
+  /// @throws std::invalid_argument if the arm cannot get there along the line within its limits
+  void moveTo(const Transform& pose) { queuePose(pose); }
+  /// Queues a joint-space motion (a straight line in joint space, see move()) to the inverse
+  /// kinematics solution of `pose` on the previous target's configuration.
   /// @throws std::invalid_argument if the inverse kinematics finds no solution within the limits
-  void moveTo(const Transform& pose) { queueJointMotion(solvePose(pose)); }
+  void moveToThroughJointSpace(const Transform& pose) { queueJointMotion(solvePose(pose)); }
 
  private:
   static int manipulatorJoints(Manipulator& manipulator);
   JointVector solvePose(const Transform& pose);
+  void queuePose(const Transform& pose);
 };
 
 /// The generator for any number of joints (`DefaultTrajectoryGenerator<>`).

@@ -45,6 +45,18 @@ class JerkLimitedProfile {
   double getPeakAcceleration() const { return ap_; }
   /// The state at time `t` (clamped to [0, duration]). Real-time safe: yes.
   ProfileState evaluate(double t) const;
+  /// The time at which the motion has covered `position` (clamped to [0, distance]); the
+  /// position grows strictly while the motion lasts, so the answer is unique.
+  /// @param[in] position  distance covered [units]
+  /// @return time [s] in [0, duration], to within 1e-12 s
+  /// Real-time safe: yes (bisection, at most 200 evaluations).
+  double timeAtPosition(double position) const;
+  /// The instants inside (0, duration) where the jerk changes (at most six), in increasing order;
+  /// between two of them the position is a cubic in time.
+  /// @param[out] times  receives the instants [s]
+  /// @return how many were written
+  /// Real-time safe: yes.
+  int getBreakpoints(double times[6]) const;
 
  private:
   ProfileState accelerationPhase(double t) const;  // 0 <= t <= ta_

@@ -1,0 +1,135 @@
+// Property test of the queue: 100,000 seeded random multi-segment joint sequences (random
+// limits, random via points, half of them with blends of random size), evaluated the way the
+// servo loop does (1 kHz). Every setpoint stays within the limits; consecutive setpoints differ by
+// at most what the limits allow over one cycle (position, velocity and acceleration are
+// continuous across segment and blend boundaries: an acceleration jump would exceed jerk * dt);
+// each sequence ends at rest exactly on its last target; an unblended sequence lasts exactly the
+// sum of the analytic time-optimal durations, a blended one no longer.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "rp/RoboticPlatform.hpp"
+
+namespace rp {
+namespace {
+
+TEST(TrajectoryProperty, RandomSequencesWithAndWithoutBlends) {
+  RoboticPlatform::setConfiguration(Configuration());
+  RoboticPlatform::setSimulationModeOn();
+  RoboticPlatform::useSimulatedClock();
+  ObjectManager::resetShutdown();
+  Puma560 puma;
+  SimulatedClock& clock = dynamic_cast<SimulatedClock&>(RoboticPlatform::getDefaultClock());
+  clock.pause();  // the test evaluates the setpoints itself
+  while (puma.getCycleCount() < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const ManipulatorModel& model = puma.getModel();
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  const int sequences = 1000;
+#else
+  const int sequences = 100000;
+#endif
+  std::mt19937_64 rng(20261122);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const double dt = 1e-3;
+  // Every sequence has its own generator and starts at t = 10 s: small absolute times keep the
+  // rounding of t (and so of the acceleration differences) far below the 1e-9 relative tolerance.
+  const double time = 10;
+  long segments = 0, blends = 0, samples = 0, vias = 0;
+  for (int s = 0; s < sequences; ++s) {
+    DefaultTrajectoryGenerator<6> tragen;
+    tragen.setSpeedFraction(1);
+    JointVector vmax(6), amax(6), jmax(6);
+    for (int i = 0; i < 6; ++i) {
+      vmax(i) = 1 + 5 * unit(rng);
+      amax(i) = 5 + 35 * unit(rng);
+      jmax(i) = 50 + 750 * unit(rng);
+    }
+    tragen.setJointLimits(vmax, amax, jmax);
+    const bool blended = s % 2 == 1;
+    tragen.setJointBlendRadius(blended ? 0.05 + unit(rng) : 0.0);
+    puma.setTrajectoryGenerator(tragen);
+    // Disconnects the generator before it is destroyed, also when an assertion returns early
+    // (a connected generator's destructor waits for its queue to finish).
+    struct Detach {
+      Puma560& arm;
+      ~Detach() { arm.clearTrajectoryGenerator(); }
+    } detach{puma};
+    const int count = 2 + static_cast<int>(rng() % 4);
+    JointVector from = tragen.getLastTarget(), last;
+    double analytic = 0;
+    for (int k = 0; k < count; ++k) {
+      JointVector q(6);
+      for (int i = 0; i < 6; ++i) {
+        q(i) = model.getPositionMin()(i) + (0.05 + 0.9 * unit(rng)) * (model.getPositionMax()(i) - model.getPositionMin()(i));
+      }
+      tragen.moveRadians(q);
+      // The analytic duration of the synchronised rest-to-rest line from `from` to `q`.
+      double vs = INFINITY, as = INFINITY, js = INFINITY;
+      for (int i = 0; i < 6; ++i) {
+        const double d = std::abs(q(i) - from(i));
+        vs = std::min(vs, vmax(i) / d);
+        as = std::min(as, amax(i) / d);
+        js = std::min(js, jmax(i) / d);
+      }
+      analytic += JerkLimitedProfile(1.0, vs, as, js).getDuration();
+      from = last = q;
+      ++segments;
+    }
+    blends += tragen.getBlendCount();
+    if (blended) vias += count - 1;
+    else EXPECT_EQ(tragen.getBlendCount(), 0);
+    Setpoint sp, prev;
+    sp.position = sp.velocity = sp.acceleration = JointVector(6);
+    prev = sp;
+    ASSERT_TRUE(tragen.getCurrentSetpoint(time, prev));
+    double t = time;
+    for (long k = 1; !tragen.isDone(); ++k) {
+      t = time + static_cast<double>(k) * dt;
+      ++samples;
+      ASSERT_TRUE(tragen.getCurrentSetpoint(t, sp));
+      for (int i = 0; i < 6; ++i) {
+        ASSERT_LE(std::abs(sp.velocity(i)), vmax(i) * (1 + 1e-9)) << "sequence " << s << " joint " << i;
+        ASSERT_LE(std::abs(sp.acceleration(i)), amax(i) * (1 + 1e-9)) << "sequence " << s << " joint " << i;
+        ASSERT_LE(std::abs(sp.acceleration(i) - prev.acceleration(i)), jmax(i) * dt * (1 + 1e-9) + 1e-12)
+            << "sequence " << s << " joint " << i << " at " << t - time;
+        ASSERT_LE(std::abs(sp.velocity(i) - prev.velocity(i)), amax(i) * dt * (1 + 1e-9) + 1e-12)
+            << "sequence " << s << " joint " << i;
+        ASSERT_LE(std::abs(sp.position(i) - prev.position(i)), vmax(i) * dt * (1 + 1e-9) + 1e-12)
+            << "sequence " << s << " joint " << i;
+      }
+      prev = sp;
+      ASSERT_LT(t - time, 1000.0);
+    }
+    if (blended) {
+      EXPECT_LE(t - time, analytic + dt + 1e-9) << "sequence " << s;
+    } else {
+      EXPECT_NEAR(t - time, analytic, dt + 1e-9) << "sequence " << s;
+    }
+    ASSERT_TRUE(tragen.getCurrentSetpoint(t + dt, sp));
+    for (int i = 0; i < 6; ++i) {
+      ASSERT_NEAR(sp.position(i), last(i), 1e-12) << "sequence " << s;
+      ASSERT_EQ(sp.velocity(i), 0.0);
+      ASSERT_EQ(sp.acceleration(i), 0.0);
+    }
+  }
+  // Most via points of a blended sequence are blended. A via point is passed at rest instead when
+  // neither overlapping the two motions nor a quintic no longer than stopping keeps the limits:
+  // typically when the same joint limits both motions' synchronised profiles, so that the jerks of
+  // the decelerating and the accelerating motion add up (about 17 % of these random via points).
+  EXPECT_GT(blends, vias * 3 / 4);
+  RecordProperty("sequences", sequences);
+  RecordProperty("segments", static_cast<int>(segments));
+  RecordProperty("blends", static_cast<int>(blends));
+  RecordProperty("samples", static_cast<int>(samples));
+  std::printf("%d sequences, %ld segments, %ld of %ld via points blended, %ld setpoints checked\n", sequences, segments,
+              blends, vias, samples);
+  clock.resume();
+}
+
+}  // namespace
+}  // namespace rp
