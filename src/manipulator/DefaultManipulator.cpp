@@ -108,6 +108,8 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   registerLogVariable("q", q_.data(), static_cast<std::size_t>(n), "rad");
   registerLogVariable("qd", qd_.data(), static_cast<std::size_t>(n), "rad/s");
   registerLogVariable("qdes", setpoint_.position.data(), static_cast<std::size_t>(n), "rad");
+  registerLogVariable("qddes", setpoint_.velocity.data(), static_cast<std::size_t>(n), "rad/s");
+  registerLogVariable("qdddes", setpoint_.acceleration.data(), static_cast<std::size_t>(n), "rad/s^2");
   registerLogVariable("tau", tau_.data(), static_cast<std::size_t>(n), "N m");
   registerParameter("kp", defaultControl_->getKp().data(), static_cast<std::size_t>(n), 0, 1e7, "N m/rad",
                     "proportional gains of the default position control");
