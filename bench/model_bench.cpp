@@ -131,6 +131,26 @@ void MassMatrix_KDL(benchmark::State& s) {
     benchmark::DoNotOptimize(M.data.data());
   }
 }
+// The gravity torque: ours from forward kinematics and link mass moments, KDL's by Newton-Euler.
+void GravityTorque_rp(benchmark::State& s) {
+  Robot& r = robot(s);
+  JointVector g(r.model->getNumberOfJoints());
+  std::size_t k = 0;
+  for (auto _ : s) {
+    gravityTorque(*r.model, *r.data, r.q[k++ & 63], g);
+    benchmark::DoNotOptimize(g.data());
+  }
+}
+void GravityTorque_KDL(benchmark::State& s) {
+  Robot& r = robot(s);
+  KDL::ChainDynParam dyn(r.chain, KDL::Vector(0, 0, -9.81));
+  KDL::JntArray g(r.chain.getNrOfJoints());
+  std::size_t k = 0;
+  for (auto _ : s) {
+    dyn.JntToGravity(r.kq[k++ & 63], g);
+    benchmark::DoNotOptimize(g.data.data());
+  }
+}
 void ForwardDynamics_rp(benchmark::State& s) {
   Robot& r = robot(s);
   std::size_t k = 0;
@@ -139,8 +159,8 @@ void ForwardDynamics_rp(benchmark::State& s) {
     benchmark::DoNotOptimize(forwardDynamics(*r.model, *r.data, r.q[i], r.qd[i], r.qdd[i]).data());
   }
 }
-// The mass-matrix route (Newton-Euler bias, Jacobian-based M, LDL^T), forwardDynamics() before
-// the articulated-body algorithm.
+// Featherstone's articulated-body algorithm (forwardDynamics() is the mass-matrix route: gravity
+// from mass moments, velocity products by a spatial Newton-Euler pass, CRBA, LDL^T).
 void ForwardDynamicsArticulatedBody_rp(benchmark::State& s) {
   Robot& r = robot(s);
   std::size_t k = 0;
@@ -286,6 +306,7 @@ RP_PAIR(ForwardKinematics);
 RP_PAIR(Jacobian);
 RP_PAIR(InverseDynamics);
 RP_PAIR(MassMatrix);
+RP_PAIR(GravityTorque);
 RP_PAIR(ForwardDynamics);
 RP_PAIR(InverseKinematics);
 

@@ -5,10 +5,11 @@
 // inertias, armature G^2 Jm, viscous damping B G^2; no contacts, timestep 1 ms, integrator Euler
 // (MuJoCo's is semi-implicit with implicit damping)). Our step also applies the model's Coulomb
 // friction as a velocity impulse (a few nanoseconds); MuJoCo gets none. The same control torques
-// are computed for both with our gravity routine. A second MuJoCo variant has no damping
-// attribute and gets the viscous torque as an applied force, so that both sides take the same
-// semi-implicit Euler step with explicit damping. Part_* entries time the pieces (our gravity
-// torque and forward dynamics, mj_step alone).
+// are computed for both with our gravity routine (so its cost is in both cycles). A second MuJoCo
+// variant has no damping attribute and gets the viscous torque as an applied force, so that both
+// sides take the same semi-implicit Euler step with explicit damping. Part_* entries time the
+// pieces (our gravity torque and forward dynamics, mj_step alone: our whole cycle against
+// mj_step alone is the strictest of the comparisons).
 //
 // The counter arms_per_core of ServoCycle_rp is 1 ms over the cycle time: an upper bound with no
 // thread switches or wake-ups; bench/arms_per_core measures arms per core in real time.
@@ -170,8 +171,10 @@ void mujocoCycle(benchmark::State& s, bool explicitDamping) {
 void ServoCycle_MuJoCo(benchmark::State& s) { mujocoCycle(s, false); }
 void ServoCycle_MuJoCoExplicitDamping(benchmark::State& s) { mujocoCycle(s, true); }
 
-// The parts of our cycle: the control law's gravity torque, and the forward dynamics inside the
-// simulation step (M by centre-of-mass Jacobians, the bias torques by Newton-Euler, LDL^T).
+// The parts of our cycle: the control law's gravity torque (forward kinematics and link mass
+// moments), and the forward dynamics inside the simulation step (in world coordinates after one
+// forward kinematics: the same gravity routine, the velocity products by a spatial Newton-Euler
+// pass, M by composite rigid bodies, an unpivoted LDL^T solve).
 void Part_rpGravityTorque(benchmark::State& s) {
   Arm& a = arm(s);
   JointVector q = a.target;
