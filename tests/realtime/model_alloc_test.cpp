@@ -23,6 +23,8 @@ TEST(ModelRealtime, AlgorithmsDoNotAllocate) {
   DynamicsOptions all;
   all.motorInertia = true;
   all.friction = true;
+  DynamicsOptions withWrench = all;
+  withWrench.tipWrench << 2, -1, 3, 0.2, 0.1, -0.3;
   std::array<Puma560IkSolution, 8> branches;
   const Transform target = forwardKinematics(puma, pd, q);
   const Transform wamTarget = forwardKinematics(wam, wd, wq);
@@ -39,6 +41,9 @@ TEST(ModelRealtime, AlgorithmsDoNotAllocate) {
     sink += massMatrix(puma, pd, q, true)(0, 0);
     sink += forwardDynamics(puma, pd, q, qd, tau, all)(2);
     sink += forwardDynamics(wam, wd, wq, JointVector(7), JointVector(7))(3);
+    // The world-frame paths with every option (motor inertia, friction, a tip wrench) on the WAM 7.
+    gravityTorque(wam, wd, wq, wout);
+    sink += forwardDynamics(wam, wd, wq, wout, wout, withWrench)(4);
     sink += forwardDynamicsArticulatedBody(puma, pd, q, qd, tau, all)(2);
     sink += puma.inverseKinematicsAll(target, branches) == IkStatus::Solved;
     sink += puma.inverseKinematicsClosest(target, q, out) == IkStatus::Solved;
