@@ -265,7 +265,8 @@ bool planBlend(const SegmentPlan& from, const SegmentPlan& to, const JointVector
   from.evaluate(from.exitTime, a);
   to.evaluate(to.entryTime, b);
   for (auto& c : blend.coefficients) c = JointVector(n);
-  const double D = shortestFeasible(stopping, [&](double d) { return tryQuintic(a, b, d, vmax, amax, jmax, blend); });
+  constexpr double kLongestQuintic = 3;  // times stopping (Blend.hpp)
+  const double D = shortestFeasible(kLongestQuintic * stopping, [&](double d) { return tryQuintic(a, b, d, vmax, amax, jmax, blend); });
   if (D < 0 || !tryQuintic(a, b, D, vmax, amax, jmax, blend)) return false;
   blend.fromStart = from.exitTime;
   blend.duration = blend.exitTime = D;

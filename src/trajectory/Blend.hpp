@@ -20,8 +20,10 @@ namespace rp::internal {
 // joint at its limit rarely can overlap), the blend is a quintic per joint from `from` at its
 // exitTime to `to` at its entryTime, matching position, velocity and acceleration at both ends,
 // with the shortest duration found (a scan, then bisection) that keeps every joint within its
-// limits, checked exactly from the polynomial's stationary points, and no longer than stopping
-// at the via point would take. Returns false if neither exists: the motions then meet at rest.
+// limits, checked exactly from the polynomial's stationary points, and at most three times as
+// long as stopping at the via point would take (so the arm passes the via point without stopping
+// even when that costs a little time; the shortest such quintic is usually shorter than
+// stopping). Returns false if neither exists: the motions then meet at rest.
 // On success `blend` is a Blend segment: an overlap's `from` and `to` point at the arguments
 // (re-point them when the plans move); blend.fromStart is where `from` ends and to.entryTime
 // must be set to `entry`.
