@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -271,6 +272,23 @@ struct ControlProgram::Impl {
     }
   }
 
+  // On the simulated clock time waits for every program, so a program may also wait for the log
+  // writer: when its ring buffer is half full it lets the writer drain it to a quarter, and no
+  // sample is lost however fast the simulation runs. (The real-time loop never waits; its buffer
+  // is sized by logBufferSize.) Gives up after about two seconds, or if the writer is closed.
+  void waitForLogRoom() {
+    if (!channel || writer == nullptr) return;
+    auto used = [this] {
+      return channel->head.load(std::memory_order_acquire) - channel->tail.load(std::memory_order_acquire);
+    };
+    if (used() * 2 < channel->capacity) return;
+    for (int i = 0; i < 20000 && !stopRequested.load(std::memory_order_relaxed) && !writer->isClosed(); ++i) {
+      writer->notify();
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+      if (used() * 4 < channel->capacity) return;
+    }
+  }
+
   void runSimulated(SimulatedClock& sim) {
     const auto ticksPerCycle =
         static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / rate / sim.getStep())));
@@ -280,6 +298,7 @@ struct ControlProgram::Impl {
       const std::int64_t start = internal::monotonicNanoseconds();
       cycle(sim.tickTime(tick), k++);
       computation.add(internal::monotonicNanoseconds() - start);
+      waitForLogRoom();
       tick += ticksPerCycle;
       if (cycleLimit && k >= cycleLimit) break;
     }

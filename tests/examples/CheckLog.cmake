@@ -1,11 +1,14 @@
 # Runs PROGRAM on the simulated clock with `-log LOG`, then checks that the CSV log has the joint
-# positions and setpoints of every manipulator and a row per logged cycle.
+# positions and setpoints of every manipulator, a row per logged cycle, and no lost sample.
 file(REMOVE ${LOG})
 execute_process(COMMAND ${PROGRAM} -nogui -simclock -log ${LOG} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err
   TIMEOUT 280)
 message("${out}${err}")
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "exit status ${rc}")
+endif()
+if("${out}${err}" MATCHES "samples lost")
+  message(FATAL_ERROR "the log lost samples (on the simulated clock nothing may be lost)")
 endif()
 if(NOT EXISTS ${LOG})
   message(FATAL_ERROR "no log file ${LOG}")

@@ -197,23 +197,45 @@ TEST(ControlProgramThreads, ProgramsWithTheSameNameGetDistinctColumns) {
   EXPECT_EQ(rows[3], "0.002,2,2,20,200,2,2,20,200");
 }
 
-TEST(ControlProgramThreads, LogRingOverflowIsCounted) {
-  auto dir = scratch("overflow");
+TEST(ControlProgramThreads, OnTheSimulatedClockTheLogLosesNothing) {
+  auto dir = scratch("simwait");
   LogWriter writer((dir / "log.csv").string());
   SimulatedClock clock(1e-3);
-  // A program that outruns the writer: its ring holds 2 samples and it runs 200000 cycles.
-  Recorder r("r", 200000);
+  // A program that would outrun the writer: its ring holds 2 samples. On the simulated clock it
+  // waits for the writer to drain the ring, so every sample reaches the file.
+  Recorder r("r", 5000);
   r.setClock(clock);
   r.setLogWriter(&writer);
   r.setLogBufferSize(2);
-  r.setCycleLimit(200000);
+  r.setCycleLimit(5000);
   r.start();
   r.waitUntilStopped();
   writer.close();
   const ControlStatistics s = r.getStatistics();
-  EXPECT_EQ(s.logSamples, 200000u);
+  EXPECT_EQ(s.logSamples, 5000u);
+  EXPECT_EQ(s.lostLogSamples, 0u);
+  EXPECT_EQ(writer.getLostSamples(), 0u);
+  EXPECT_EQ(lines(dir / "log.csv").size(), 1u + 5000u);
+}
+
+TEST(ControlProgramThreads, LogRingOverflowIsCountedOnTheRealClock) {
+  auto dir = scratch("overflow");
+  LogWriter writer((dir / "log.csv").string());
+  // On the real clock the loop never waits for the writer: with a ring of 2 samples at 10 kHz
+  // samples are lost, and every lost one is counted (the file has exactly the others).
+  Recorder r("r", 2000);
+  r.setClock(RealClock::instance());
+  r.setRate(10000);
+  r.setLogWriter(&writer);
+  r.setLogBufferSize(2);
+  r.setCycleLimit(2000);
+  r.start();
+  r.waitUntilStopped();
+  writer.close();
+  const ControlStatistics s = r.getStatistics();
+  EXPECT_EQ(s.logSamples, 2000u);
   EXPECT_EQ(writer.getLostSamples(), s.lostLogSamples);
-  EXPECT_EQ(lines(dir / "log.csv").size(), 1 + 200000 - s.lostLogSamples);
+  EXPECT_EQ(lines(dir / "log.csv").size(), 1 + 2000 - s.lostLogSamples);
 }
 
 TEST(ControlProgramThreads, RealClockRunsAndReportsStatistics) {
