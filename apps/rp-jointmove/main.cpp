@@ -42,8 +42,12 @@ class JointFollower : public rp::TrajectoryGenerator {
       amax_[i] = 0.5 * model.getAccelerationLimit()(i);
       target_[i].store(start(i));
     }
+    publishObject();  // complete: the Scene Viewer may use it
   }
-  ~JointFollower() override { releaseFromManipulators(); }
+  ~JointFollower() override {
+    withdrawObject();  // first: the Scene Viewer keeps off from here on
+    releaseFromManipulators();
+  }
 
   void attach(rp::Manipulator& manipulator) override {
     if (manipulator.getNumberOfJoints() != n_)

@@ -30,8 +30,11 @@ using nlohmann::json;
 // the viewer's worker thread, one at a time). Motions run in a thread of their own.
 class Teachpendant : public rp::RoboticObject {
  public:
-  Teachpendant(const std::string& name, rp::Manipulator& arm) : rp::RoboticObject(name), arm_(arm) {}
+  Teachpendant(const std::string& name, rp::Manipulator& arm) : rp::RoboticObject(name), arm_(arm) {
+    publishObject();  // complete: the Scene Viewer may send it messages
+  }
   ~Teachpendant() override {
+    withdrawObject();  // first: waits for a message being handled; no new ones reach it
     abort_ = true;
     if (job_.joinable()) job_.join();
     generator_.reset();

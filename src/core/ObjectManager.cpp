@@ -89,6 +89,33 @@ RoboticObject* ObjectManager::findObject(const std::string& name) const {
   return nullptr;
 }
 
+std::vector<ObjectReference> ObjectManager::getPublishedObjects() const {
+  auto& reg = internal::registry();
+  std::vector<ObjectReference> out;
+  std::lock_guard<std::recursive_mutex> lock(reg.mutex);  // keeps every listed object's base alive
+  out.reserve(reg.objects.size());
+  for (RoboticObject* o : reg.objects)
+    if (o->tryReference()) out.push_back(ObjectReference(o));
+  return out;
+}
+
+ObjectReference ObjectManager::findPublishedObject(const std::string& name) const {
+  auto& reg = internal::registry();
+  std::lock_guard<std::recursive_mutex> lock(reg.mutex);
+  for (RoboticObject* o : reg.objects)
+    if (o->getName() == name) return o->tryReference() ? ObjectReference(o) : ObjectReference();
+  return {};
+}
+
+std::vector<std::string> ObjectManager::getObjectNames() const {
+  auto& reg = internal::registry();
+  std::lock_guard<std::recursive_mutex> lock(reg.mutex);
+  std::vector<std::string> out;
+  out.reserve(reg.objects.size());
+  for (RoboticObject* o : reg.objects) out.push_back(o->getName());
+  return out;
+}
+
 std::vector<ObjectInfo> ObjectManager::getObjectList() const {
   std::vector<ObjectInfo> out;
   forEachObject([&](RoboticObject& o) { out.push_back(o.getInfo()); });
@@ -123,6 +150,7 @@ const TypeInfo& ObjectManager::checkedClass(const std::string& name, const std::
 RoboticObject* ObjectManager::create(const TypeInfo& info, const std::string& name) {
   std::unique_ptr<RoboticObject> object(info.create(name));
   RoboticObject* raw = object.get();
+  raw->publishObject();  // the most-derived constructor has returned
   auto& reg = internal::registry();
   std::lock_guard<std::recursive_mutex> lock(reg.mutex);
   reg.owned.push_back(std::move(object));
@@ -147,7 +175,8 @@ void ObjectManager::deleteObject(RoboticObject* object) {
     victim = std::move(*it);
     reg.owned.erase(it);
   }
-  victim.reset();  // outside the lock: its destructor may stop a thread
+  victim->withdrawObject();  // before its destruction begins (waits for other threads' references)
+  victim.reset();            // outside the lock: its destructor may stop a thread
 }
 
 void ObjectManager::deleteAllObjects() {
@@ -157,7 +186,10 @@ void ObjectManager::deleteAllObjects() {
     std::lock_guard<std::recursive_mutex> lock(reg.mutex);
     victims.swap(reg.owned);
   }
-  while (!victims.empty()) victims.pop_back();  // newest first
+  while (!victims.empty()) {  // newest first
+    victims.back()->withdrawObject();
+    victims.pop_back();
+  }
 }
 
 void ObjectManager::requestSystemShutdown(const char* reason) noexcept {

@@ -43,7 +43,7 @@ PhysicalObject::PhysicalObject(const std::string& name) : RoboticObject(name), p
   }
 }
 
-PhysicalObject::~PhysicalObject() = default;
+PhysicalObject::~PhysicalObject() { withdrawObject(); }  // first thing for a plain PhysicalObject
 
 void PhysicalObject::declareSettings(SettingSchema& schema) {
   RoboticObject::declareSettings(schema);

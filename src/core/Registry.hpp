@@ -21,6 +21,10 @@ struct Registry {
   std::vector<RoboticObject*> objects;
   std::vector<std::unique_ptr<RoboticObject>> owned;  // created by ObjectManager
   std::atomic<std::uint64_t> nextId{1};
+  // Object references (RoboticObject::withdrawObject waits here; never destroyed, so a releasing
+  // thread may notify after the object it released is gone).
+  std::mutex referenceMutex;
+  std::condition_variable referenceCv;
 
   // System shutdown.
   std::atomic<int> requested{0};

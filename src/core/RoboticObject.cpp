@@ -32,6 +32,9 @@ std::string demangleName(const char* mangled) {
   return name;
 }
 
+// The references the calling thread holds (withdrawObject() does not wait for its own thread's).
+thread_local std::vector<const RoboticObject*> heldReferences;
+
 }  // namespace internal
 
 struct RoboticObject::Impl {
@@ -48,6 +51,13 @@ struct RoboticObject::Impl {
 
   std::atomic<bool> shuttingDown{false};
   std::atomic<bool> shutdownComplete{false};
+
+  // Publication to other threads: 0 not yet published, 1 published, 2 withdrawn. `references`
+  // counts the ObjectReferences held; withdrawObject() waits for it to drop (Registry::referenceCv).
+  std::atomic<int> publication{0};
+  std::atomic<int> references{0};
+  std::thread::id constructor;           // the thread that constructed the object
+  const RoboticObject* parent = nullptr;  // published with this object (with the registry lock)
 
   std::mutex commandMutex;
   struct Command {
@@ -69,6 +79,7 @@ RoboticObject::RoboticObject(const std::string& name) : impl_(std::make_unique<I
         if (o->impl_->name == name)
           throw std::invalid_argument("RoboticObject: an object named '" + name + "' already exists");
     impl_->id = reg.nextId.fetch_add(1);
+    impl_->constructor = std::this_thread::get_id();
     // Automatic names do not depend on the class: other threads may list the object while it is
     // still being constructed, when its dynamic class is not yet known.
     impl_->name = name.empty() ? "object_" + std::to_string(impl_->id) : name;
@@ -78,6 +89,7 @@ RoboticObject::RoboticObject(const std::string& name) : impl_(std::make_unique<I
 }
 
 RoboticObject::~RoboticObject() {
+  withdrawObject();  // normally done already by the most-derived destructor
   auto& reg = internal::registry();
   std::lock_guard<std::recursive_mutex> lock(reg.mutex);
   reg.objects.erase(std::remove(reg.objects.begin(), reg.objects.end(), this), reg.objects.end());
@@ -199,10 +211,87 @@ void RoboticObject::startControlLoop() {
     if (p->getProgramName() == "control") p->setProgramName(getName());
     if (!p->isRunning()) p->start();
   }
+  publishObject();  // the most-derived constructor calls this last: the object is complete
 }
 
 void RoboticObject::stopControlLoop() {
+  withdrawObject();  // the destructors call this first: other threads keep off from here on
   if (ControlProgram* p = getControlProgram()) p->stop();
+}
+
+void RoboticObject::publishObject() noexcept {
+  auto& reg = internal::registry();
+  const std::thread::id self = std::this_thread::get_id();
+  std::lock_guard<std::recursive_mutex> lock(reg.mutex);
+  if (impl_->constructor == self) {
+    // Objects this thread registered after this one and has not published are complete (they
+    // were constructed inside this object's constructor, e.g. its members, or after it): they
+    // are published with it, and withdrawn with it.
+    for (RoboticObject* o : reg.objects)
+      if (o->impl_->id > impl_->id && o->impl_->constructor == self && o->impl_->publication.load() == 0) {
+        o->impl_->parent = this;
+        o->impl_->publication.store(1, std::memory_order_seq_cst);
+      }
+  }
+  impl_->publication.store(1, std::memory_order_seq_cst);
+}
+
+void RoboticObject::withdrawObject() noexcept {
+  auto& reg = internal::registry();
+  std::vector<RoboticObject*> withdrawn{this};
+  {
+    std::lock_guard<std::recursive_mutex> lock(reg.mutex);
+    impl_->publication.store(2, std::memory_order_seq_cst);
+    for (RoboticObject* o : reg.objects)  // the objects published with this one go with it
+      if (o->impl_->parent == this && o->impl_->publication.load() == 1) {
+        o->impl_->publication.store(2, std::memory_order_seq_cst);
+        withdrawn.push_back(o);
+      }
+  }
+  // Every reference taken before the stores is released before we go on; a reference attempted
+  // after them sees `2` and is given back at once (tryReference: increment, then check).
+  const auto& held = internal::heldReferences;
+  std::unique_lock<std::mutex> lock(reg.referenceMutex);
+  for (RoboticObject* o : withdrawn) {
+    const int own = static_cast<int>(std::count(held.begin(), held.end(), o));
+    reg.referenceCv.wait(lock, [&] { return o->impl_->references.load(std::memory_order_seq_cst) <= own; });
+  }
+}
+
+bool RoboticObject::isObjectPublished() const noexcept { return impl_->publication.load() == 1; }
+
+bool RoboticObject::tryReference() noexcept {
+  impl_->references.fetch_add(1, std::memory_order_seq_cst);
+  if (impl_->publication.load(std::memory_order_seq_cst) != 1) {
+    auto& reg = internal::registry();
+    {
+      std::lock_guard<std::mutex> lock(reg.referenceMutex);
+      impl_->references.fetch_sub(1, std::memory_order_seq_cst);
+    }
+    reg.referenceCv.notify_all();
+    return false;
+  }
+  try {
+    internal::heldReferences.push_back(this);
+  } catch (...) {
+    releaseReference();
+    return false;
+  }
+  return true;
+}
+
+void RoboticObject::releaseReference() noexcept {
+  auto& held = internal::heldReferences;
+  auto it = std::find(held.rbegin(), held.rend(), this);
+  if (it != held.rend()) held.erase(std::next(it).base());
+  auto& reg = internal::registry();
+  {
+    // Under the mutex: a withdrawing thread checks the count under it too, so it cannot go on
+    // (and destroy the object) before this decrement is done.
+    std::lock_guard<std::mutex> lock(reg.referenceMutex);
+    impl_->references.fetch_sub(1, std::memory_order_seq_cst);
+  }
+  reg.referenceCv.notify_all();  // the object may be gone now: only the registry is used
 }
 
 ObjectInfo RoboticObject::getInfo() {

@@ -33,9 +33,11 @@ AtiFTSensor::AtiFTSensor(const std::string& name) : ForceTorqueSensor(name) {
   } else {
     client_ = std::make_unique<NetFtClient>(config);
   }
+  publishObject();  // complete: other threads (the Scene Viewer) may use it
 }
 
 AtiFTSensor::~AtiFTSensor() {
+  withdrawObject();  // first: other threads keep off from here on
   if (streaming_) client_->stopStreaming();
 }
 

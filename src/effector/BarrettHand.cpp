@@ -33,9 +33,10 @@ BarrettHand::BarrettHand(const std::string& name) : Gripper(name) {
     driver_ = std::make_unique<BarrettHandSerial>(config_);
   }
   addCommand("Initialize", [this] { initialize(); }, "initialise the hand (HI)");
+  publishObject();  // complete: other threads (the Scene Viewer) may use it
 }
 
-BarrettHand::~BarrettHand() = default;
+BarrettHand::~BarrettHand() { withdrawObject(); }  // first: other threads keep off from here on
 
 void BarrettHand::declareSettings(SettingSchema& schema) {
   Gripper::declareSettings(schema);

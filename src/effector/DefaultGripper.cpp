@@ -9,16 +9,20 @@ namespace rp {
 
 DefaultGripper::DefaultGripper(const std::string& name) : Gripper(name) {
   const ConfigSection* section = configSection();
-  if (section == nullptr) return;
+  if (section == nullptr) {
+    publishObject();  // complete: other threads (the Scene Viewer) may use it
+    return;
+  }
   internal::TwoLineBoard b = internal::createTwoLineBoard(*section, "openLine", "closeLine");
   ownedBoard_ = std::move(b.board);
   board_ = ownedBoard_.get();
   openLine_ = b.lineA;
   closeLine_ = b.lineB;
   if (!b.deviceError.empty()) setError(1, (getName() + ": " + b.deviceError).c_str());
+  publishObject();  // complete: other threads (the Scene Viewer) may use it
 }
 
-DefaultGripper::~DefaultGripper() = default;
+DefaultGripper::~DefaultGripper() { withdrawObject(); }  // first: other threads keep off from here on
 
 void DefaultGripper::declareSettings(SettingSchema& schema) {
   Gripper::declareSettings(schema);

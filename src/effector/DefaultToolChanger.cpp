@@ -9,16 +9,20 @@ namespace rp {
 
 DefaultToolChanger::DefaultToolChanger(const std::string& name) : ToolChanger(name) {
   const ConfigSection* section = configSection();
-  if (section == nullptr) return;
+  if (section == nullptr) {
+    publishObject();  // complete: other threads (the Scene Viewer) may use it
+    return;
+  }
   internal::TwoLineBoard b = internal::createTwoLineBoard(*section, "lockLine", "unlockLine");
   ownedBoard_ = std::move(b.board);
   board_ = ownedBoard_.get();
   lockLine_ = b.lineA;
   unlockLine_ = b.lineB;
   if (!b.deviceError.empty()) setError(1, (getName() + ": " + b.deviceError).c_str());
+  publishObject();  // complete: other threads (the Scene Viewer) may use it
 }
 
-DefaultToolChanger::~DefaultToolChanger() = default;
+DefaultToolChanger::~DefaultToolChanger() { withdrawObject(); }  // first: other threads keep off from here on
 
 void DefaultToolChanger::declareSettings(SettingSchema& schema) {
   ToolChanger::declareSettings(schema);

@@ -3,11 +3,13 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <set>
 
 #include "rp/core/ObjectManager.hpp"
 #include "rp/effector/Gripper.hpp"
 #include "rp/gui/SceneViewer.hpp"
+#include "rp/gui/UrdfVisuals.hpp"
 #include "rp/manipulator/Manipulator.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/ManipulatorData.hpp"
@@ -84,13 +86,24 @@ void putTransform(std::string& out, const Transform& t) {
 
 }  // namespace
 
+// The <visual> elements of a UrdfManipulator's URDF file (its rp.cfg settings `urdf` and `tip`),
+// read once per object.
+void SceneState::loadVisuals(Entry& e) {
+  e.urdfLoaded = true;
+  const ConfigSection* section = e.object->configSection();
+  if (!section || !section->has("urdf")) return;
+  std::string file = section->getWord("urdf");
+  if (std::filesystem::path(file).is_relative())
+    file = (std::filesystem::path(section->fileName()).parent_path() / file).string();
+  try {
+    e.urdfShapes = loadUrdfVisuals(file, section->has("tip") ? section->getWord("tip") : "");
+  } catch (const std::exception& ex) {
+    e.urdfError = ex.what();
+  }
+}
+
 SceneState::SceneState() = default;
 SceneState::~SceneState() = default;
-
-// An object whose control loop has stopped is left alone: the destructors of objects with a loop
-// stop it first thing (RoboticObject::stopControlLoop), so this keeps the viewer off objects being
-// destroyed (the page keeps showing their last state). Objects without a loop have no such signal.
-bool SceneState::retiring(const Entry& e) { return e.program != nullptr && !e.program->isRunning(); }
 
 json SceneState::describe(Entry& e) {
   RoboticObject& o = *e.object;
@@ -142,6 +155,14 @@ json SceneState::describe(Entry& e) {
   e.frames.clear();
   if (e.physical) {
     Model3D m = e.physical->get3DModel();
+    if (e.manipulator && o.getClassName() == "UrdfManipulator") {
+      if (!e.urdfLoaded) loadVisuals(e);
+      if (!e.urdfShapes.empty()) {
+        m.shapes = e.urdfShapes;  // the URDF's own look instead of the generic links
+        j["urdfVisuals"] = true;
+      }
+      if (!e.urdfError.empty()) j["urdfError"] = e.urdfError;
+    }
     e.frames = m.frames;
     json shapes = json::array();
     e.meshes.clear();
@@ -176,33 +197,54 @@ json SceneState::describe(Entry& e) {
 }
 
 bool SceneState::refresh() {
-  std::set<RoboticObject*> present;
+  ObjectManager om;
+  // References keep the published objects from being withdrawn (destroyed) while we read them.
+  std::vector<ObjectReference> published = om.getPublishedObjects();
+  std::map<std::string, RoboticObject*> byName;  // published objects
+  for (const ObjectReference& r : published) byName[r->getName()] = r.get();
   json objects = json::array();
-  ObjectManager().forEachObject([&](RoboticObject& o) {
-    present.insert(&o);
-    const std::string name = o.getName();  // safe at any time
-    auto it = entries_.find(&o);
-    if (it == entries_.end() || it->second.name != name) {
-      // New (or a new object at the address of a destroyed one): only recorded this time, since
-      // it may still be under construction.
-      Entry e;
-      e.object = &o;
-      e.name = name;
-      e.sightings = 1;
-      entries_[&o] = std::move(e);
-      return;
+  std::set<RoboticObject*> present;
+  for (auto& [object, e] : entries_) e.index = -1;  // set again below for the objects listed now
+  // In creation order; only names are read of objects not published (being constructed, or of a
+  // class that does not publish itself) or withdrawn (being destroyed): safe at any time.
+  for (const std::string& name : om.getObjectNames()) {
+    auto live = byName.find(name);
+    if (live != byName.end()) {
+      RoboticObject* o = live->second;
+      present.insert(o);
+      auto it = entries_.find(o);
+      if (it == entries_.end() || it->second.name != name) {
+        Entry e;  // new (or a new object at the address of a destroyed one)
+        e.object = o;
+        e.name = name;
+        it = entries_.insert_or_assign(o, std::move(e)).first;
+      }
+      Entry& e = it->second;
+      e.index = static_cast<int>(objects.size());
+      e.description = describe(e);
+      e.described = true;
+      objects.push_back(e.description);
+      continue;
     }
-    Entry& e = it->second;
-    ++e.sightings;
-    e.index = static_cast<int>(objects.size());
-    if (e.described && retiring(e)) {
-      objects.push_back(e.description);  // as last described
-      return;
+    Entry* last = nullptr;
+    for (auto& [object, e] : entries_)
+      if (e.name == name && e.described && !present.count(object)) last = &e;
+    if (last) {
+      objects.push_back(last->description);  // withdrawn: as last described, without state
+      present.insert(last->object);
+    } else {
+      objects.push_back({{"path", "/objects/" + name},
+                         {"name", name},
+                         {"className", ""},
+                         {"kind", "unpublished"},
+                         {"published", false},
+                         {"physical", false},
+                         {"hasControlLoop", false},
+                         {"error", {{"code", 0}, {"message", ""}}},
+                         {"commands", json::array()},
+                         {"panel", {{"title", name}, {"fields", json::array()}}}});
     }
-    e.description = describe(e);
-    objects.push_back(e.description);
-    e.described = true;
-  });
+  }
   for (auto it = entries_.begin(); it != entries_.end();)
     it = present.count(it->first) ? std::next(it) : entries_.erase(it);
   std::string dump = objects.dump();
@@ -236,9 +278,14 @@ std::string SceneState::buildFrame() {
   std::uint32_t count = 0;
   double time = 0;
 
-  ObjectManager().forEachObject([&](RoboticObject& o) {
+  // References keep every object read here (and the mounts looked up) from being destroyed.
+  std::vector<ObjectReference> published = ObjectManager().getPublishedObjects();
+  std::set<const RoboticObject*> live;
+  for (const ObjectReference& r : published) live.insert(r.get());
+  for (const ObjectReference& r : published) {
+    RoboticObject& o = *r;
     auto it = entries_.find(&o);
-    if (it == entries_.end() || !it->second.described || it->second.index < 0 || retiring(it->second)) return;
+    if (it == entries_.end() || !it->second.described || it->second.index < 0) continue;
     Entry& e = it->second;
     StateSnapshot snap;
     const bool hasState = o.getStateSnapshot(snap);
@@ -267,7 +314,7 @@ std::string SceneState::buildFrame() {
       PhysicalObject* child = e.physical;
       for (int depth = 0; depth < 16; ++depth) {
         PhysicalObject* mount = child->getConnection();
-        if (!mount) break;
+        if (!mount || !live.count(mount)) break;  // a mount not published is not read
         Transform frame = mount->getTransform();
         if (auto* m = dynamic_cast<Manipulator*>(mount)) {
           const std::string f = child->getConnectionFrame();
@@ -303,7 +350,7 @@ std::string SceneState::buildFrame() {
     for (const Transform& p : poses) putTransform(out, p);
     for (int i = 0; i < values; ++i) putDouble(out, snap.values[i]);
     ++count;
-  });
+  }
   for (int i = 0; i < 4; ++i) out[countAt + static_cast<std::size_t>(i)] = static_cast<char>((count >> (8 * i)) & 0xffu);
   std::string t;
   putDouble(t, time);

@@ -31,9 +31,10 @@ class SceneState {
   SceneState(const SceneState&) = delete;
   SceneState& operator=(const SceneState&) = delete;
 
-  // Looks at the object list; objects seen for the first time are only recorded (they may still
-  // be under construction), objects seen before are described. Returns true if the scene
-  // description changed (then scene() has a new version).
+  // Looks at the object list: published objects are described (through ObjectReferences, so
+  // none can be destroyed meanwhile), objects not published yet are listed by name only, and a
+  // withdrawn object keeps its last description until it leaves the list. Returns true if the
+  // scene description changed (then sceneMessage() has a new version).
   bool refresh();
   // The scene message: {"type": "scene", "protocol", "version", "objects": [...]}.
   const std::string& sceneMessage() const { return sceneMessage_; }
@@ -49,7 +50,6 @@ class SceneState {
   struct Entry {
     RoboticObject* object = nullptr;
     std::string name;
-    int sightings = 0;
     bool described = false;
     PhysicalObject* physical = nullptr;
     Manipulator* manipulator = nullptr;
@@ -59,9 +59,12 @@ class SceneState {
     int index = -1;  // position in the scene's object array
     nlohmann::json description;  // the last description
     std::vector<std::string> meshes;  // mesh file of each shape (empty for other shapes)
+    bool urdfLoaded = false;          // a UrdfManipulator's visuals were looked for
+    std::vector<Shape> urdfShapes;    // its URDF <visual> elements (empty: none)
+    std::string urdfError;            // why they could not be read
   };
   nlohmann::json describe(Entry& e);
-  static bool retiring(const Entry& e);
+  static void loadVisuals(Entry& e);
 
   std::map<RoboticObject*, Entry> entries_;
   std::string sceneMessage_;

@@ -21,6 +21,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <mutex>
 #include <random>
 #include <set>
@@ -32,6 +33,7 @@
 #include "rp/core/PhysicalObject.hpp"
 #include "rp/core/RoboticPlatform.hpp"
 #include "rp/rt/ControlProgram.hpp"
+#include "rp/rt/LogWriter.hpp"
 
 #ifndef RP_WEB_ROOT_BUILD
 #define RP_WEB_ROOT_BUILD ""
@@ -55,6 +57,8 @@ constexpr std::size_t kMaxMessageBytes = 64 * 1024;  // largest WebSocket messag
 constexpr std::size_t kMaxTextQueue = 256;           // replies and scenes waiting for a slow page
 constexpr std::size_t kMaxWorkQueue = 128;           // commands waiting for the worker thread
 constexpr std::size_t kMaxStringField = 256;         // longest name, command or message type
+constexpr std::size_t kMaxLogColumns = 32;           // log columns one page may plot
+constexpr std::size_t kMaxLogBatch = 2000;           // samples per column in one batch
 constexpr int kPortFallbacks = 20;
 
 std::string& startPageStorage() {
@@ -140,6 +144,7 @@ struct SceneViewer::Impl {
   internal::SceneState scene;
   std::chrono::steady_clock::time_point lastRefresh{};
   std::chrono::steady_clock::duration period{};
+  std::chrono::steady_clock::time_point lastLogPush{};
 
   // Worker thread for commands that touch objects (they may block, e.g. a serial device).
   std::thread worker;
@@ -157,6 +162,9 @@ struct SceneViewer::Impl {
   void tick();
   bool refreshScene(bool force);
   void onMessage(const std::shared_ptr<WsSession>& session, std::string text, bool binary);
+  bool onLogMessage(const std::shared_ptr<WsSession>& session, const std::string& type, const json& msg, const json& id,
+                    const std::function<void(const std::string&)>& refuse);
+  void pushLogSamples();
   bool enqueueWork(std::function<void()> job);
   void workerLoop();
 };
@@ -200,6 +208,13 @@ class SceneViewer::Impl::WsSession : public std::enable_shared_from_this<SceneVi
     state_ = frame;
     write();
   }
+
+  // Text messages waiting to be written (log samples are not sent while many wait).
+  std::size_t queuedText() const { return text_.size(); }
+
+  // The log columns this page plots (QMotor), and the time of the last sample sent.
+  std::vector<std::string> logColumns;
+  std::vector<double> logAfter;  // per column
 
   void close() {
     if (closed_) return;
@@ -400,6 +415,7 @@ void SceneViewer::Impl::tick() {
   });
   if (sessions.empty()) return;  // nothing to do without pages: no cost to the program
   refreshScene(false);
+  pushLogSamples();
   auto frame = std::make_shared<const std::string>(scene.buildFrame());
   framesBuilt.fetch_add(1);
   for (const auto& s : std::vector<std::shared_ptr<WsSession>>(sessions.begin(), sessions.end())) s->sendState(frame);
@@ -425,6 +441,16 @@ void SceneViewer::Impl::workerLoop() {
     }
     job();
   }
+}
+
+// A reference to the published object `name` (held while a command uses it, so the object cannot
+// be destroyed meanwhile); throws with a message for the page if there is none.
+static ObjectReference publishedObject(const std::string& name) {
+  ObjectManager om;
+  ObjectReference o = om.findPublishedObject(name);
+  if (o) return o;
+  if (om.findObject(name)) throw std::invalid_argument("object '" + name + "' is not published (being constructed or destroyed, or its class does not publish it)");
+  throw std::invalid_argument("no object '" + name + "'");
 }
 
 void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std::string text, bool binary) {
@@ -469,6 +495,8 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
   if (type == "ping") return session->sendText(json{{"type", "pong"}, {"id", id}}.dump());
   if (type == "scene") return session->sendText(scene.sceneMessage());
 
+  if (onLogMessage(session, type, msg, id, refuse)) return;
+
   std::string object;
   if (!str("object", object)) return;
   std::function<std::string()> action;  // runs in the worker; returns the reply text; throws on failure
@@ -476,8 +504,7 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     std::string command;
     if (!str("command", command)) return;
     action = [object, command] {
-      RoboticObject* o = ObjectManager().findObject(object);
-      if (!o) throw std::invalid_argument("no object '" + object + "'");
+      ObjectReference o = publishedObject(object);
       o->executeCommand(command);
       return std::string();
     };
@@ -486,8 +513,9 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     if (!str("mode", mode)) return;
     if (mode != "off" && mode != "solid" && mode != "wireframe") return refuse("'mode' must be off, solid or wireframe");
     action = [object, mode] {
-      auto* o = ObjectManager().findObject<PhysicalObject>(object);
-      if (!o) throw std::invalid_argument("no physical object '" + object + "'");
+      ObjectReference ref = publishedObject(object);
+      auto* o = ref.as<PhysicalObject>();
+      if (!o) throw std::invalid_argument("'" + object + "' is not a physical object");
       o->setDisplayMode(mode == "off" ? DisplayMode::Off : mode == "solid" ? DisplayMode::Solid : DisplayMode::Wireframe);
       return std::string();
     };
@@ -515,8 +543,7 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     for (double v : values)
       if (!std::isfinite(v)) return refuse("parameter values must be finite");
     action = [object, name, values, index] {
-      RoboticObject* o = ObjectManager().findObject(object);
-      if (!o) throw std::invalid_argument("no object '" + object + "'");
+      ObjectReference o = publishedObject(object);
       ControlProgram* p = o->getControlProgram();
       if (!p) throw std::invalid_argument("object '" + object + "' has no tunable parameters");
       if (values.size() > 1) p->setParameter(name, values);
@@ -534,15 +561,15 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
       payload = p->get<std::string>();
     }
     action = [object, messageType, payload] {
-      RoboticObject* o = ObjectManager().findObject(object);
-      if (!o) throw std::invalid_argument("no object '" + object + "'");
+      ObjectReference o = publishedObject(object);
       std::string reply;
       if (!o->handleMessage(messageType, payload, reply))
         throw std::invalid_argument("object '" + object + "' does not understand the message '" + messageType + "'");
       return reply;
     };
   } else {
-    return refuse("unknown message type '" + type + "' (known: hello, ping, scene, command, display, setParameter, message)");
+    return refuse("unknown message type '" + type +
+                  "' (known: hello, ping, scene, command, display, setParameter, message, logInfo, logging, logSubscribe)");
   }
 
   std::weak_ptr<WsSession> weak = session;
@@ -562,6 +589,99 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     });
   });
   if (!queued) refuse("the server is busy (too many commands waiting)");
+}
+
+// QMotor's log messages: logInfo (the log file, whether it is logging, its columns), logging {on}
+// (start or stop logging to the file) and logSubscribe {columns} (the columns this page plots).
+// Returns false for any other type.
+bool SceneViewer::Impl::onLogMessage(const std::shared_ptr<WsSession>& session, const std::string& type,
+                                     const json& msg, const json& id,
+                                     const std::function<void(const std::string&)>& refuse) {
+  if (type != "logInfo" && type != "logging" && type != "logSubscribe") return false;
+  LogWriter* writer = LogWriter::getPlatformWriter();
+  if (!writer || writer->isClosed()) {
+    refuse("the program writes no log file (start it with -log FILE)");
+    return true;
+  }
+  auto info = [&] {
+    return json{{"file", writer->fileName()}, {"logging", writer->isLogging()}, {"columns", writer->getColumns()}};
+  };
+  if (type == "logInfo") {
+    session->sendText(json{{"type", "result"}, {"id", id}, {"ok", true}, {"reply", info().dump()}}.dump());
+  } else if (type == "logging") {
+    auto on = msg.find("on");
+    if (on == msg.end() || !on->is_boolean()) {
+      refuse("'on' must be true or false");
+      return true;
+    }
+    if (on->get<bool>()) writer->startLogging();
+    else writer->stopLogging();
+    session->sendText(json{{"type", "result"}, {"id", id}, {"ok", true}, {"reply", info().dump()}}.dump());
+    // Every page shows whether the program is logging.
+    const std::string note = json{{"type", "logState"}, {"logging", writer->isLogging()}}.dump();
+    for (const auto& s : std::vector<std::shared_ptr<WsSession>>(sessions.begin(), sessions.end()))
+      if (s != session) s->sendText(note);
+  } else {  // logSubscribe
+    auto columns = msg.find("columns");
+    if (columns == msg.end() || !columns->is_array() || columns->size() > kMaxLogColumns) {
+      refuse("'columns' must be an array of at most " + std::to_string(kMaxLogColumns) + " column names");
+      return true;
+    }
+    const std::vector<std::string> known = writer->getColumns();
+    std::vector<std::string> chosen;
+    for (const json& c : *columns) {
+      if (!c.is_string() || c.get<std::string>().empty() || c.get<std::string>().size() > kMaxStringField) {
+        refuse("'columns' must hold names of 1 to 256 characters");
+        return true;
+      }
+      const std::string name = c.get<std::string>();
+      if (std::find(known.begin(), known.end(), name) == known.end()) {
+        refuse("'" + name + "' is not a column of the log " + writer->fileName());
+        return true;
+      }
+      if (std::find(chosen.begin(), chosen.end(), name) == chosen.end()) chosen.push_back(name);
+    }
+    // Columns already plotted go on from their last sample; new ones get the recent samples.
+    std::vector<double> after(chosen.size(), -std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < chosen.size(); ++i)
+      for (std::size_t j = 0; j < session->logColumns.size(); ++j)
+        if (session->logColumns[j] == chosen[i]) after[i] = session->logAfter[j];
+    session->logAfter = std::move(after);
+    session->logColumns = std::move(chosen);
+    session->sendText(json{{"type", "result"}, {"id", id}, {"ok", true}, {"reply", info().dump()}}.dump());
+  }
+  return true;
+}
+
+// Sends each page that plots log columns the samples taken since its last batch (20 batches a
+// second; a page with many messages still queued gets its samples in a later, larger batch).
+void SceneViewer::Impl::pushLogSamples() {
+  const auto now = std::chrono::steady_clock::now();
+  if (now - lastLogPush < std::chrono::milliseconds(50)) return;
+  lastLogPush = now;
+  LogWriter* writer = LogWriter::getPlatformWriter();
+  if (!writer || writer->isClosed()) return;
+  for (const auto& s : std::vector<std::shared_ptr<WsSession>>(sessions.begin(), sessions.end())) {
+    if (s->logColumns.empty() || s->queuedText() > 8) continue;
+    json out = json::array();
+    bool any = false;
+    for (std::size_t i = 0; i < s->logColumns.size(); ++i) {
+      std::vector<LogSeries> series;
+      try {
+        series = writer->getRecentSamples({s->logColumns[i]}, s->logAfter[i], kMaxLogBatch);
+      } catch (const std::exception&) {
+        continue;  // the writer was closed meanwhile
+      }
+      const LogSeries& l = series.front();
+      if (!l.time.empty()) {
+        s->logAfter[i] = l.time.back();
+        any = true;
+      }
+      out.push_back({{"column", l.column}, {"t", l.time}, {"v", l.value}});
+    }
+    if (!any) continue;
+    s->sendText(json{{"type", "logSamples"}, {"series", out}}.dump());
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <deque>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -46,12 +47,29 @@ struct LogWriter::Impl {
   std::mutex closeMutex;
   std::atomic<bool> closed{false};
   std::atomic<std::uint64_t> rows{0};
+  bool logging = true;  // with `mutex`: samples drained while false are not written to the file
+  // The newest samples of each channel (index as `channels`), each 1 + width doubles; kept only
+  // from the first getRecentSamples() call on (a log nobody plots costs nothing more).
+  std::vector<std::deque<std::vector<double>>> recent;
+  bool keepRecent = false;
 
   // With `mutex` held: moves every available sample into `staging`, then writes the rows no
   // program can add to any more (all times up to the slowest running program's last sample).
   void drain(bool all) {
-    for (auto& c : channels) {
+    for (std::size_t k = 0; k < channels.size(); ++k) {
+      auto& c = channels[k];
       while (const double* s = c->front()) {
+        if (keepRecent) {
+          auto& history = recent[k];
+          if (history.size() >= LogWriter::kRecentSamples) history.pop_front();
+          history.emplace_back(s, s + c->width + 1);
+        }
+        if (!logging) {  // stopped: the sample is only kept for the plots
+          c->lastTime = s[0];
+          c->any = true;
+          c->pop();
+          continue;
+        }
         Row& row = staging[s[0]];
         if (row.values.size() < totalColumns) {
           row.values.resize(totalColumns, 0.0);
@@ -126,6 +144,64 @@ void LogWriter::addChannel(const std::shared_ptr<Channel>& channel) {
   channel->firstColumn = impl_->totalColumns;
   impl_->totalColumns += channel->width;
   impl_->channels.push_back(channel);
+  impl_->recent.emplace_back();
+}
+
+void LogWriter::stopLogging() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (impl_->closed.load() || !impl_->logging) return;
+  impl_->drain(false);  // what was taken before this call goes to the file
+  impl_->logging = false;
+}
+
+void LogWriter::startLogging() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (impl_->closed.load() || impl_->logging) return;
+  impl_->drain(false);  // what was taken while stopped stays out of the file
+  impl_->logging = true;
+}
+
+bool LogWriter::isLogging() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->logging;
+}
+
+std::vector<std::string> LogWriter::getColumns() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  std::vector<std::string> out;
+  for (auto& c : impl_->channels) out.insert(out.end(), c->columns.begin(), c->columns.end());
+  return out;
+}
+
+std::vector<LogSeries> LogWriter::getRecentSamples(const std::vector<std::string>& columns, double afterTime,
+                                                   std::size_t maxSamples) const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->keepRecent = true;
+  if (!impl_->closed.load()) impl_->drain(false);  // include what the programs took since the last pass
+  std::vector<LogSeries> out;
+  for (const std::string& name : columns) {
+    LogSeries series;
+    series.column = name;
+    bool found = false;
+    for (std::size_t k = 0; k < impl_->channels.size() && !found; ++k) {
+      const auto& c = impl_->channels[k];
+      for (std::size_t i = 0; i < c->width && !found; ++i) {
+        if (c->columns[i] != name) continue;
+        found = true;
+        const auto& history = impl_->recent[k];
+        // Newest samples after `afterTime`, oldest first.
+        std::size_t first = history.size();
+        while (first > 0 && history[first - 1][0] > afterTime && history.size() - first < maxSamples) --first;
+        for (std::size_t j = first; j < history.size(); ++j) {
+          series.time.push_back(history[j][0]);
+          series.value.push_back(history[j][i + 1]);
+        }
+      }
+    }
+    if (!found) throw std::invalid_argument("LogWriter " + impl_->fileName + ": no log column '" + name + "'");
+    out.push_back(std::move(series));
+  }
+  return out;
 }
 
 void LogWriter::notify() { impl_->cv.notify_all(); }

@@ -12,7 +12,10 @@ namespace {
 
 class MeshPart : public PhysicalObject {
  public:
-  MeshPart(const std::string& name, std::string file) : PhysicalObject(name), file_(std::move(file)) {}
+  MeshPart(const std::string& name, std::string file) : PhysicalObject(name), file_(std::move(file)) {
+    publishObject();  // complete: the Scene Viewer may use it
+  }
+  ~MeshPart() override { withdrawObject(); }  // first: the Scene Viewer keeps off from here on
   Model3D get3DModel() const override {
     Model3D m;
     Shape mesh;

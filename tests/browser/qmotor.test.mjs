@@ -1,7 +1,11 @@
 // Browser test of the QMotor window (-qmotor): its URL is printed, a plot receives samples of the
-// arm's joint positions, and the tunable parameters are there.
-import { describe, it } from 'node:test';
+// arm's joint positions, and the tunable parameters are there; with -log FILE a log variable picked
+// from the list of the program's log columns is plotted live, and Stop/Start logging leave a gap
+// in the log file; bad log requests are refused.
+import { describe, it, after } from 'node:test';
 import assert from 'node:assert/strict';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { withProgram, openViewer, waitInPage, sleep } from './harness.mjs';
 
@@ -26,8 +30,84 @@ describe('QMotor window on work_cell -qmotor', () => {
     await page.check('#fields input[data-field="tau"]');
     await waitInPage(page, () => window.rp.series.length === 12);
     assert.ok(await page.locator('.panel input[data-field="kp"]').count() === 6, 'no tunable kp in the window');
+    // Without -log there is no log to plot or start: the window says so.
+    await waitInPage(page, () => document.getElementById('log-state').textContent.includes('-log FILE'));
     await sleep(500);
     if (shots) await page.screenshot({ path: join(shots, 'qmotor.png') });
     await page.close();
+  });
+});
+
+describe('QMotor log variables on work_cell -log FILE -qmotor', () => {
+  const dir = mkdtempSync(join(tmpdir(), 'rp-qmotor-log-'));
+  const logFile = join(dir, 'qmotor-log.csv');
+  const ctx = withProgram('work_cell', ['-gui-port', '0', '-qmotor', '--arm-only', '-log', logFile]);
+  after(() => rmSync(dir, { recursive: true, force: true }));
+
+  it('plots a picked log variable and stops and starts logging to the file', async () => {
+    const url = ctx.program.output().match(/rp: QMotor at (\S+)/)[1];
+    const page = await openViewer(ctx.browser, `${url}?object=puma`, { width: 1100, height: 900 });
+    // The list holds the program's log columns; pick one.
+    await page.waitForSelector('#log-columns input[data-column="puma.q[1]"]');
+    const info = await page.evaluate(() => window.rp.logInfo);
+    assert.equal(info.file, logFile);
+    assert.equal(info.logging, true);
+    for (const c of ['puma.q[0]', 'puma.qd[5]', 'puma.tau[2]', 'puma.qdes[3]']) assert.ok(info.columns.includes(c), c);
+    await page.check('#log-columns input[data-column="puma.q[1]"]');
+    await page.fill('#log-filter', 'tau');
+    await page.check('#log-columns input[data-column="puma.tau[1]"]');
+    await waitInPage(page, () => window.rp.logSeries.length === 2 && window.rp.logData['puma.q[1]'].t.length > 300);
+    const last = () => page.evaluate(() => { const t = window.rp.logData['puma.q[1]'].t; return t[t.length - 1]; });
+    const q = await page.evaluate(() => window.rp.logData['puma.q[1]']);
+    for (let i = 1; i < q.t.length; ++i) assert.ok(q.t[i] > q.t[i - 1], 'sample times do not increase');
+    // Samples at the servo rate (1 kHz), not the 60 Hz display rate.
+    assert.ok((q.t.length - 1) / (q.t[q.t.length - 1] - q.t[0]) > 500, 'fewer than 500 samples a second');
+    assert.ok(Math.max(...q.v) - Math.min(...q.v) > 1e-3, 'joint 2 does not move in the plot');
+    await page.waitForSelector('#log-plot .u-wrap canvas');
+    if (shots) await page.screenshot({ path: join(shots, 'qmotor-log.png'), fullPage: true });
+
+    // Stop logging, let a second of samples pass (they still reach the plot), start again.
+    await page.click('#log-stop');
+    await waitInPage(page, () => document.getElementById('log-state').textContent === 'stopped');
+    const tStop = await last();
+    await waitInPage(page, (t) => { const a = window.rp.logData['puma.q[1]'].t; return a[a.length - 1] > t + 1.0; }, tStop);
+    const tStart = await last();
+    await page.click('#log-start');
+    await waitInPage(page, () => document.getElementById('log-state').textContent === 'logging');
+    await waitInPage(page, (t) => { const a = window.rp.logData['puma.q[1]'].t; return a[a.length - 1] > t + 1.0; }, tStart);
+
+    // Bad log requests are refused with a message; the program goes on.
+    const refused = await page.evaluate(async () => {
+      const out = [];
+      for (const m of [{ type: 'logging', on: 'yes' }, { type: 'logging' }, { type: 'logSubscribe', columns: 'puma.q[1]' },
+        { type: 'logSubscribe', columns: ['no.such[0]'] }, { type: 'logSubscribe', columns: [7] },
+        { type: 'logSubscribe', columns: Array.from({ length: 40 }, (_, i) => `puma.q[${i % 6}]`) }]) {
+        try {
+          await window.rp.conn.request(m);
+          out.push('accepted');
+        } catch (e) {
+          out.push(e.message);
+        }
+      }
+      return out;
+    });
+    assert.equal(refused.length, 6);
+    for (const r of refused) assert.notEqual(r, 'accepted', JSON.stringify(refused));
+    assert.match(refused[0], /'on' must be true or false/);
+    assert.match(refused[3], /'no\.such\[0\]' is not a column/);
+    await page.close();
+
+    // The file: rows before the stop and after the start, none in between.
+    await ctx.program.stop();
+    const rows = readFileSync(logFile, 'utf8').trim().split('\n');
+    const header = rows[0].split(',');
+    assert.equal(header[0], 't');
+    assert.ok(header.includes('puma.q[1]'));
+    const times = rows.slice(1).map((r) => Number(r.split(',')[0]));
+    const gap = times.filter((t) => t > tStop + 0.3 && t < tStart);
+    assert.equal(gap.length, 0, `${gap.length} rows logged while logging was stopped (${tStop}..${tStart})`);
+    assert.ok(times.some((t) => t < tStop), 'no rows before the stop');
+    assert.ok(times.some((t) => t > tStart + 0.3), 'no rows after the start');
+    assert.ok(times.filter((t) => t <= tStop).length > 300, 'too few rows before the stop');
   });
 });

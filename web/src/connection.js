@@ -36,7 +36,9 @@ export function decodeFrame(buffer) {
 
 // Connection to the program: calls onScene(scene), onFrame(frame), onStatus(text, connected).
 export class Connection {
-  constructor({ onScene, onFrame, onStatus, onError } = {}) {
+  constructor({ onScene, onFrame, onStatus, onError, onMessage, onOpen } = {}) {
+    this.onMessage = onMessage || (() => {}); // other server messages (logSamples, logState)
+    this.onOpen = onOpen || (() => {});
     this.onScene = onScene || (() => {});
     this.onFrame = onFrame || (() => {});
     this.onStatus = onStatus || (() => {});
@@ -62,6 +64,7 @@ export class Connection {
       this.connected = true;
       this.onStatus('connected', true);
       this.send({ type: 'hello', protocol: PROTOCOL });
+      this.onOpen();
     };
     ws.onclose = () => {
       this.connected = false;
@@ -95,6 +98,8 @@ export class Connection {
           if (msg.type === 'result') p.resolve(msg);
           else p.reject(new Error(msg.message));
         } else if (msg.type === 'error') this.onError(msg.message);
+      } else {
+        this.onMessage(msg);
       }
     };
   }

@@ -25,7 +25,7 @@ export class ObjectList {
   setScene(scene) {
     const rows = scene.objects.map((o) =>
       el('tr', { 'data-object': o.name, oncontextmenu: (ev) => { ev.preventDefault(); this.onMenu(o.name, ev.clientX, ev.clientY); } },
-        el('td', {}, o.name), el('td', {}, o.className)));
+        el('td', {}, o.name), el('td', {}, o.published === false ? '(not published)' : o.className)));
     const table = el('table', { id: 'object-table' },
       el('thead', {}, el('tr', {}, el('th', {}, 'Name'), el('th', {}, 'Class'))), el('tbody', {}, ...rows));
     this.container.replaceChildren(table);
@@ -49,7 +49,7 @@ export class PopupMenu {
     const item = (label, action) =>
       el('div', { class: 'item', 'data-action': label, onclick: (ev) => { ev.stopPropagation(); this.hide(); action(); } }, label);
     const run = (p) => p.then(() => {}).catch((e) => this.notify(`${desc.name}: ${e.message}`));
-    const items = [el('div', { class: 'title' }, `${desc.name} (${desc.className})`)];
+    const items = [el('div', { class: 'title' }, `${desc.name} (${desc.published === false ? 'not published' : desc.className})`)];
     if (desc.physical) {
       items.push(item(desc.display === 'off' ? 'Show' : 'Hide', () => run(this.conn.display(desc.name, desc.display === 'off' ? 'solid' : 'off'))));
       items.push(item('Solid', () => run(this.conn.display(desc.name, 'solid'))));

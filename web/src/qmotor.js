@@ -129,3 +129,158 @@ window.rp = {
   get series() { return series.map((s) => s.label); },
   get data() { return data; },
 };
+
+// ---- Log variables: plots of any column of the program's log file, and start/stop logging ----
+const LOG_HISTORY = 10; // seconds shown
+const logEl = {
+  file: document.getElementById('log-file'),
+  state: document.getElementById('log-state'),
+  columns: document.getElementById('log-columns'),
+  filter: document.getElementById('log-filter'),
+  plot: document.getElementById('log-plot'),
+  start: document.getElementById('log-start'),
+  stop: document.getElementById('log-stop'),
+};
+const logChosen = new Set((params.get('log') || '').split(',').filter(Boolean));
+let logInfo = null;
+let logPlot = null;
+let logSeries = []; // column names, as plotted
+let logData = { t: [], v: [] }; // per column: times and values
+let logSamples = 0;
+let logDirty = false;
+
+function showLogState(logging) {
+  logEl.state.textContent = logging ? 'logging' : 'stopped';
+  logEl.state.className = logging ? 'on' : 'off';
+  if (logInfo) logInfo.logging = logging;
+}
+
+function makeLogPlot() {
+  if (logPlot) logPlot.destroy();
+  logPlot = null;
+  if (!logSeries.length) return;
+  const colors = ['#1f77b4', '#ff7f0e', '#2ca02c', '#d62728', '#9467bd', '#8c564b', '#e377c2', '#7f7f7f'];
+  logPlot = new uPlot({
+    width: logEl.plot.clientWidth || 700,
+    height: 260,
+    scales: { x: { time: false } },
+    axes: [{ label: 'time [s]' }, {}],
+    series: [{ label: 't' }, ...logSeries.map((c, i) => ({ label: c, stroke: colors[i % colors.length], width: 1.5 }))],
+  }, [[], ...logSeries.map(() => [])], logEl.plot);
+}
+
+// The plotted data: the union of the columns' times (programs may sample at different times).
+function logPlotData() {
+  const times = [...new Set(logSeries.flatMap((c) => logData[c].t))].sort((a, b) => a - b);
+  const index = new Map(times.map((t, i) => [t, i]));
+  return [times, ...logSeries.map((c) => {
+    const out = new Array(times.length).fill(null);
+    logData[c].t.forEach((t, i) => { out[index.get(t)] = logData[c].v[i]; });
+    return out;
+  })];
+}
+
+async function subscribeLog() {
+  logSeries = [...logChosen];
+  const old = logData;
+  logData = {};
+  for (const c of logSeries) logData[c] = old[c] || { t: [], v: [] }; // columns kept go on
+  makeLogPlot();
+  try {
+    await conn.request({ type: 'logSubscribe', columns: logSeries });
+  } catch (e) {
+    notify(`log: ${e.message}`);
+  }
+}
+
+function buildLogColumns() {
+  const f = logEl.filter.value.trim();
+  const boxes = logInfo.columns.filter((c) => !f || c.includes(f)).map((c) => {
+    const label = document.createElement('label');
+    const box = document.createElement('input');
+    box.type = 'checkbox';
+    box.dataset.column = c;
+    box.checked = logChosen.has(c);
+    box.addEventListener('change', () => {
+      if (box.checked) logChosen.add(c);
+      else logChosen.delete(c);
+      subscribeLog();
+    });
+    label.append(box, ` ${c}`);
+    return label;
+  });
+  logEl.columns.replaceChildren(...boxes);
+}
+
+async function loadLog() {
+  try {
+    const r = await conn.request({ type: 'logInfo' });
+    logInfo = JSON.parse(r.reply);
+    logEl.file.textContent = logInfo.file;
+    showLogState(logInfo.logging);
+    for (const c of [...logChosen]) if (!logInfo.columns.includes(c)) logChosen.delete(c);
+    buildLogColumns();
+    subscribeLog();
+  } catch (e) {
+    logInfo = null;
+    logEl.file.textContent = '';
+    logEl.state.textContent = e.message;
+    logEl.state.className = 'off';
+    logEl.columns.replaceChildren();
+  }
+}
+
+async function setLogging(on) {
+  try {
+    const r = await conn.request({ type: 'logging', on });
+    showLogState(JSON.parse(r.reply).logging);
+  } catch (e) {
+    notify(`log: ${e.message}`);
+  }
+}
+
+logEl.start.addEventListener('click', () => setLogging(true));
+logEl.stop.addEventListener('click', () => setLogging(false));
+logEl.filter.addEventListener('input', () => logInfo && buildLogColumns());
+conn.onOpen = () => loadLog();
+if (conn.connected) loadLog();
+conn.onMessage = (msg) => {
+  if (msg.type === 'logState') showLogState(msg.logging);
+  if (msg.type !== 'logSamples') return;
+  for (const s of msg.series) {
+    const d = logData[s.column];
+    if (!d) continue;
+    // A batch may overlap what is plotted (a new subscription replays the recent samples).
+    const after = d.t.length ? d.t[d.t.length - 1] : -Infinity;
+    for (let i = 0; i < s.t.length; ++i) {
+      if (s.t[i] <= after) continue;
+      d.t.push(s.t[i]);
+      d.v.push(s.v[i]);
+      logSamples++;
+    }
+    const last = d.t[d.t.length - 1];
+    let drop = 0;
+    while (drop < d.t.length && d.t[drop] < last - LOG_HISTORY) drop++;
+    if (drop) {
+      d.t.splice(0, drop);
+      d.v.splice(0, drop);
+    }
+  }
+  logDirty = true;
+};
+const redrawLog = () => {
+  requestAnimationFrame(redrawLog);
+  if (logDirty && logPlot) {
+    logPlot.setData(logPlotData());
+    logDirty = false;
+  }
+};
+redrawLog();
+new ResizeObserver(() => logPlot && logPlot.setSize({ width: logEl.plot.clientWidth || 700, height: 260 })).observe(logEl.plot);
+
+Object.defineProperties(window.rp, Object.getOwnPropertyDescriptors({
+  get logInfo() { return logInfo; },
+  get logSamples() { return logSamples; },
+  get logSeries() { return logSeries; },
+  get logData() { return logData; },
+}));

@@ -154,7 +154,7 @@ export class SceneView {
       (frameByName.get(s.frame) || frames[0]).add(holder);
     });
     const o = { root, frames, desc, key, materials, bones: [], fingers: null };
-    if (desc.kind === 'manipulator') {
+    if (desc.kind === 'manipulator' && !desc.urdfVisuals) { // a URDF arm is drawn by its own visuals
       const linkMat = material([0.55, 0.6, 0.7, 1]);
       for (let i = 0; i + 1 < frames.length; ++i) {
         const bone = new THREE.Mesh(unitCylinder, linkMat);

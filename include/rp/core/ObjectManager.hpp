@@ -52,6 +52,18 @@ class ObjectManager {
   T* findObject(const std::string& name) const {
     return dynamic_cast<T*>(findObject(name));
   }
+  /// References to every published object (see RoboticObject::publishObject()), in creation
+  /// order: while a reference is held, the object's destruction cannot begin, so another thread
+  /// (the Scene Viewer) may call its functions. Objects not yet published, or withdrawn, are left
+  /// out. Real-time safe: no.
+  std::vector<ObjectReference> getPublishedObjects() const;
+  /// A reference to the published object called `name`; empty if there is none (or it is not
+  /// published). Real-time safe: no.
+  /// @param[in] name  object name
+  ObjectReference findPublishedObject(const std::string& name) const;
+  /// The names of all live objects in creation order, published or not (a name is safe to read
+  /// at any time). Real-time safe: no.
+  std::vector<std::string> getObjectNames() const;
   /// Name and class of every live object (plain data for the GUI's object list).
   std::vector<ObjectInfo> getObjectList() const;
   /// Calls `f` for each live object while holding the registry lock (objects cannot be

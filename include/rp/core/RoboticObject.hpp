@@ -14,6 +14,8 @@
 namespace rp {
 
 class ControlProgram;
+class ObjectManager;
+class ObjectReference;
 
 /// What a GUI field shows or edits.
 enum class FieldKind {
@@ -85,9 +87,13 @@ struct ObjectInfo {
 /// an object created without a name gets a unique automatic name such as `object_3`.
 ///
 /// Threads: an object is in the ObjectManager's list from the start of its construction to the
-/// end of its destruction. Its name is safe to read from any thread at any time; its virtual
-/// functions only while it is complete (other threads should not use objects that may be in
-/// construction or destruction; derived classes stop their control loop first in their destructor).
+/// end of its destruction. Its name is safe to read from any thread at any time. Other threads
+/// (the Scene Viewer) use anything else only while the object is *published*: from the end of its
+/// construction (publishObject(), called last by the most-derived constructor, by
+/// startControlLoop() and by the ObjectManager's factory) to the start of its destruction
+/// (withdrawObject(), called first by the most-derived destructor, by stopControlLoop() and by
+/// ObjectManager::deleteObject()), and only through an ObjectReference, which withdrawObject()
+/// waits for. The servo threads never take part in this: they neither wait for it nor delay it.
 ///
 /// Classes that can be named in rp.cfg have a constructor taking `const std::string& name`
 /// and are registered with RP_REGISTER_CLASS (see TypeDatabase.hpp). The settings a class
@@ -203,10 +209,12 @@ class RoboticObject {
   /// Whether the object needs a control loop.
   bool needsControlLoop() { return getControlProgram() != nullptr; }
   /// Starts the object's control loop in its own thread (the most-derived constructor calls this
-  /// last, so the loop never sees a half-constructed object). Does nothing without a loop.
+  /// last, so the loop never sees a half-constructed object), then publishes the object
+  /// (publishObject()). Without a loop it only publishes the object.
   /// Real-time safe: no.
   void startControlLoop();
-  /// Stops the control loop and waits for its thread (derived destructors call this first).
+  /// Withdraws the object from other threads (withdrawObject()), then stops the control loop and
+  /// waits for its thread (derived destructors call this first).
   /// Real-time safe: no.
   void stopControlLoop();
   /// @}
@@ -214,13 +222,98 @@ class RoboticObject {
   /// A plain description of the object for the object list. Real-time safe: no.
   ObjectInfo getInfo();
 
+  /// @name Publication to other threads
+  /// @{
+
+  /// Publishes the object: from now on other threads may use it through an ObjectReference
+  /// (ObjectManager::getPublishedObjects()). Call it last in the most-derived constructor, after
+  /// which nothing of the object is written without its own synchronisation; startControlLoop()
+  /// and ObjectManager's factory call it. A program may call it for an object of a class that
+  /// does not (for example a plain PhysicalObject) once the object is constructed.
+  ///
+  /// Called by the thread that constructed the object, it also publishes the objects that thread
+  /// constructed after this one and has not published (they are complete: the objects this
+  /// object's constructor made, such as its members, or objects made after it); they are
+  /// withdrawn with this object, so they must not be destroyed before it by another thread.
+  /// Real-time safe: no (takes the object registry's lock).
+  void publishObject() noexcept;
+  /// Withdraws the object (and the objects published with it) from other threads: no new
+  /// ObjectReference to them can be taken, and the call waits until every reference other
+  /// threads hold has been released. Call it first in the
+  /// most-derived destructor; stopControlLoop(), ObjectManager::deleteObject() and the
+  /// destructors of RoboticObject and PhysicalObject call it (later than ideal for derived classes).
+  /// References held by the calling thread itself are not waited for.
+  /// Real-time safe: no (waits for other threads' references).
+  void withdrawObject() noexcept;
+  /// Whether the object is published (constructed and not withdrawn). Real-time safe: yes.
+  bool isObjectPublished() const noexcept;
+  /// @}
+
  protected:
   /// Marks the shutdown complete (for classes overriding startShutdown()). Real-time safe: yes.
   void setShutdownComplete() noexcept;
 
  private:
+  friend class ObjectManager;
+  friend class ObjectReference;
+  bool tryReference() noexcept;  // takes a reference if published
+  void releaseReference() noexcept;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+/// A counted reference to a published object (see RoboticObject::publishObject()): while it is
+/// held, the object's withdrawObject() waits, so its destruction cannot begin. Move-only; obtained
+/// from ObjectManager::getPublishedObjects() or ObjectManager::findPublishedObject(). Hold it only
+/// as long as the object is used, never while waiting for the object's owner thread, and release
+/// it in the thread that took it.
+class ObjectReference {
+ public:
+  /// An empty reference.
+  ObjectReference() noexcept = default;
+  /// Releases the reference.
+  ~ObjectReference() { reset(); }
+  /// Takes over another reference.
+  /// @param[in,out] other  reference left empty
+  ObjectReference(ObjectReference&& other) noexcept : object_(other.object_) { other.object_ = nullptr; }
+  /// Releases this reference and takes over another.
+  /// @param[in,out] other  reference left empty
+  /// @return this reference
+  ObjectReference& operator=(ObjectReference&& other) noexcept {
+    if (this != &other) {
+      reset();
+      object_ = other.object_;
+      other.object_ = nullptr;
+    }
+    return *this;
+  }
+  ObjectReference(const ObjectReference&) = delete;             ///< not copyable
+  ObjectReference& operator=(const ObjectReference&) = delete;  ///< not copyable
+
+  /// The object, or nullptr for an empty reference. Real-time safe: yes.
+  RoboticObject* get() const noexcept { return object_; }
+  /// The object (the reference must not be empty).
+  RoboticObject* operator->() const noexcept { return object_; }
+  /// The object (the reference must not be empty).
+  RoboticObject& operator*() const noexcept { return *object_; }
+  /// Whether the reference holds an object.
+  explicit operator bool() const noexcept { return object_ != nullptr; }
+  /// The object as a `T*` if it is derived from `T`, else nullptr.
+  template <typename T>
+  T* as() const {
+    return dynamic_cast<T*>(object_);
+  }
+  /// Releases the reference (it becomes empty). Real-time safe: yes.
+  void reset() noexcept {
+    if (object_) object_->releaseReference();
+    object_ = nullptr;
+  }
+
+ private:
+  friend class ObjectManager;
+  explicit ObjectReference(RoboticObject* referenced) noexcept : object_(referenced) {}
+  RoboticObject* object_ = nullptr;
 };
 
 }  // namespace rp

@@ -3,13 +3,22 @@
 /// LogWriter: writes the log samples of control programs to one CSV file from a
 /// non-real-time thread.
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace rp {
 
 class ControlProgram;
+
+/// Recent samples of one log column (see LogWriter::getRecentSamples()).
+struct LogSeries {
+  std::string column;         ///< column name, e.g. `puma.q[0]`
+  std::vector<double> time;   ///< sample times on the program's clock [s], increasing
+  std::vector<double> value;  ///< one value per time
+};
 
 /// Collects the log samples of any number of control programs and writes them to one CSV file.
 ///
@@ -42,6 +51,42 @@ class LogWriter {
   std::uint64_t getRowCount() const;
   /// Samples lost to ring-buffer overflow, summed over programs.
   std::uint64_t getLostSamples() const;
+
+  /// @name Starting and stopping (QMotor's start/stop logging)
+  /// @{
+
+  /// Stops writing samples to the file: every sample taken before the call is still written,
+  /// samples taken after it are left out of the file (they still reach getRecentSamples()).
+  /// Samples are taken by the real-time loops as before; only the writer leaves them out.
+  /// Does nothing if already stopped. Real-time safe: no (drains the ring buffers first).
+  void stopLogging();
+  /// Starts writing samples to the file again (samples taken after the call); the rows of the
+  /// stopped interval are missing from the file. Real-time safe: no.
+  void startLogging();
+  /// Whether samples are being written to the file (true from construction until stopLogging()).
+  bool isLogging() const;
+  /// @}
+
+  /// @name Reading the samples (live plots)
+  /// @{
+
+  /// The column names (`program.variable` or `program.vector[i]`) in file order, without `t`.
+  /// Real-time safe: no.
+  std::vector<std::string> getColumns() const;
+  /// The samples of each column taken after `afterTime`, at most the newest `maxSamples`. From the
+  /// first call on, the writer keeps the last kRecentSamples of every program, whether logging to
+  /// the file or not (before it, none: a log nobody reads this way costs nothing more).
+  /// @param[in] columns     column names
+  /// @param[in] afterTime   only samples with a later time [s]
+  /// @param[in] maxSamples  at most this many per column (the newest)
+  /// @return one series per column, in the order asked
+  /// @throws std::invalid_argument naming a column that is not in the log
+  /// Real-time safe: no.
+  std::vector<LogSeries> getRecentSamples(const std::vector<std::string>& columns, double afterTime,
+                                          std::size_t maxSamples = 4096) const;
+  /// How many of each program's newest samples getRecentSamples() can return.
+  static constexpr std::size_t kRecentSamples = 8192;
+  /// @}
 
   /// The platform's writer (from `-log FILE`), or nullptr.
   static LogWriter* getPlatformWriter();

@@ -1,0 +1,73 @@
+// Browser test of URDF visuals: rp-jointmove drives a UrdfManipulator made from
+// tests/browser/data/visual_arm.urdf (rp.cfg `urdf`); the Scene Viewer draws the arm's own
+// <visual> elements (box, cylinders, sphere, STL mesh) on the right links, and they move with the
+// joints: the sphere at link l3's origin is where the URDF's kinematics puts it for the joint
+// positions of the same state frame, before and after a joint moves.
+import { describe, it, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { dirname, join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { withProgram, openViewer, waitInPage, canvasStats, pixelsChanged } from './harness.mjs';
+
+const shots = process.env.RP_SCREENSHOT_DIR;
+const here = dirname(fileURLToPath(import.meta.url));
+const dir = mkdtempSync(join(tmpdir(), 'rp-urdf-'));
+writeFileSync(join(dir, 'rp.cfg'), `[arm]\nclass UrdfManipulator\nurdf ${join(here, 'data', 'visual_arm.urdf')}\n`);
+
+// Where the URDF puts link l3's origin for joints q (written out from the file: base -> j1 at
+// z 0.1 about z, j2 0.3 higher about y, j3 0.4 along the rotated x about y).
+function l3Origin([q1, q2]) {
+  const r = 0.4 * Math.cos(q2);
+  return [Math.cos(q1) * r, Math.sin(q1) * r, 0.1 + 0.3 - 0.4 * Math.sin(q2)];
+}
+
+describe('URDF visuals of a UrdfManipulator', () => {
+  const ctx = withProgram('rp-jointmove', ['-gui-port', '0', '-config', join(dir, 'rp.cfg'), 'arm']);
+  after(() => rmSync(dir, { recursive: true, force: true }));
+
+  // The sphere's world position in the page's 3D scene and the joint positions of the same frame.
+  const sample = (page) => page.evaluate(() => {
+    const o = window.rp.view.objects.get('arm');
+    const link3 = o.frames.find((g) => g.name === 'link3');
+    const sphere = link3.children[0];
+    const p = sphere.getWorldPosition(sphere.position.clone());
+    const f = window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'arm');
+    return { p: [p.x, p.y, p.z], q: f.values.slice(0, 3) };
+  });
+
+  it('draws the arm\'s own visuals on its links, moving with the joints', async () => {
+    assert.match(ctx.program.output(), /rp-jointmove: moving arm \(UrdfManipulator, 3 joints\)/);
+    const page = await openViewer(ctx.browser, ctx.url.replace('jointmove.html', 'index.html'));
+    const desc = await page.evaluate(() => window.rp.scene.objects.find((o) => o.name === 'arm'));
+    assert.equal(desc.urdfVisuals, true, JSON.stringify(desc.urdfError));
+    assert.deepEqual(desc.shapes.map((s) => [s.kind, s.frame]), [['cylinder', 'base'], ['box', 'link1'], ['cylinder', 'link2'],
+      ['sphere', 'link3'], ['mesh', 'link3'], ['box', 'link3']]);
+    // The STL mesh is served and drawn; no generic link cylinders ("bones") are drawn.
+    await waitInPage(page, () => window.rp.view.meshes.loaded >= 1);
+    assert.equal(await page.evaluate(() => window.rp.view.objects.get('arm').bones.length), 0);
+    const before = await sample(page);
+    const want0 = l3Origin(before.q);
+    for (let i = 0; i < 3; ++i) assert.ok(Math.abs(before.p[i] - want0[i]) < 1e-6, `l3 at ${before.p}, URDF says ${want0}`);
+    const still = await canvasStats(page);
+    assert.ok(still.foreground > 0.01 * still.total, `only ${still.foreground} pixels drawn`);
+    if (shots) await page.screenshot({ path: join(shots, 'urdf-visuals.png') });
+
+    // Move joints 1 and 2 through Joint Move; the visuals follow.
+    for (const [joint, value] of [[0, 0.9], [1, -0.6]])
+      await ctx.page.evaluate(([j, v]) => window.rp.conn.message('jointmove', 'setJoint', JSON.stringify({ joint: j, value: v })), [joint, value]);
+    await waitInPage(page, () => {
+      const f = window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'arm');
+      return Math.abs(f.values[0] - 0.9) < 0.01 && Math.abs(f.values[1] + 0.6) < 0.01;
+    }, undefined, 30000);
+    const moved = await sample(page);
+    const want1 = l3Origin(moved.q);
+    for (let i = 0; i < 3; ++i) assert.ok(Math.abs(moved.p[i] - want1[i]) < 1e-6, `l3 at ${moved.p}, URDF says ${want1}`);
+    assert.ok(Math.hypot(...moved.p.map((x, i) => x - before.p[i])) > 0.1, 'the sphere did not move');
+    const after2 = await canvasStats(page);
+    assert.ok(pixelsChanged(still, after2) > 50, 'the picture did not change as the arm moved');
+    assert.deepEqual(page.rpErrors, []);
+    await page.close();
+  });
+});
