@@ -198,6 +198,9 @@ json SceneState::describe(Entry& e) {
 
 bool SceneState::refresh() {
   ObjectManager om;
+  // The names first: no reference is held while the registry's lock is taken (a thread that
+  // withdraws an object never waits for references with that lock held, but this keeps it simple).
+  const std::vector<std::string> names = om.getObjectNames();
   // References keep the published objects from being withdrawn (destroyed) while we read them.
   std::vector<ObjectReference> published = om.getPublishedObjects();
   std::map<std::string, RoboticObject*> byName;  // published objects
@@ -207,7 +210,7 @@ bool SceneState::refresh() {
   for (auto& [object, e] : entries_) e.index = -1;  // set again below for the objects listed now
   // In creation order; only names are read of objects not published (being constructed, or of a
   // class that does not publish itself) or withdrawn (being destroyed): safe at any time.
-  for (const std::string& name : om.getObjectNames()) {
+  for (const std::string& name : names) {
     auto live = byName.find(name);
     if (live != byName.end()) {
       RoboticObject* o = live->second;
