@@ -55,9 +55,9 @@ TEST(LogControl, StopAndStartChangeWhatTheFileHolds) {
     p.setLogWriter(&writer);
     p.setLogBufferSize(2048);
     p.setCycleLimit(1000);
+    EXPECT_TRUE(writer.getRecentSamples({}, 0.0).empty());  // from this first call on it keeps samples
     p.start();
     EXPECT_EQ(writer.getColumns(), (std::vector<std::string>{"p.x", "p.q[0]", "p.q[1]"}));
-    EXPECT_TRUE(writer.getRecentSamples({"p.x"}, -1.0)[0].time.empty());  // from now on it keeps them
     clock.resume();
     p.waitUntilStopped();
     EXPECT_TRUE(writer.isLogging());
