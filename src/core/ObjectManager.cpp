@@ -225,9 +225,20 @@ std::string ObjectManager::getShutdownReason() {
 std::vector<std::string> ObjectManager::shutdownAllObjects(const std::string& reason) {
   (void)reason;
   auto& reg = internal::registry();
-  // The registry stays locked: no object can be destroyed halfway through its shutdown.
+  // The registry stays locked, and published objects are held by references: their destruction
+  // cannot begin halfway through their shutdown (it waits). Objects being destroyed (withdrawn)
+  // are left to their destructors; objects never published are shut down as they are.
   std::lock_guard<std::recursive_mutex> lock(reg.mutex);
-  std::vector<RoboticObject*> objects = reg.objects;
+  std::vector<ObjectReference> held;
+  std::vector<RoboticObject*> objects;
+  for (RoboticObject* o : reg.objects) {
+    if (o->tryReference()) {
+      held.push_back(ObjectReference(o));
+      objects.push_back(o);
+    } else if (!reg.withdrawn.count(o)) {
+      objects.push_back(o);
+    }
+  }
   for (RoboticObject* o : objects) {
     try {
       o->startShutdown();

@@ -93,6 +93,7 @@ RoboticObject::~RoboticObject() {
   auto& reg = internal::registry();
   std::lock_guard<std::recursive_mutex> lock(reg.mutex);
   reg.objects.erase(std::remove(reg.objects.begin(), reg.objects.end(), this), reg.objects.end());
+  reg.withdrawn.erase(this);
 }
 
 void RoboticObject::declareSettings(SettingSchema&) {}
@@ -233,6 +234,7 @@ void RoboticObject::publishObject() noexcept {
         o->impl_->publication.store(1, std::memory_order_seq_cst);
       }
   }
+  reg.withdrawn.erase(this);
   impl_->publication.store(1, std::memory_order_seq_cst);
 }
 
@@ -242,9 +244,11 @@ void RoboticObject::withdrawObject() noexcept {
   {
     std::lock_guard<std::recursive_mutex> lock(reg.mutex);
     impl_->publication.store(2, std::memory_order_seq_cst);
+    reg.withdrawn.insert(this);
     for (RoboticObject* o : reg.objects)  // the objects published with this one go with it
       if (o->impl_->parent == this && o->impl_->publication.load() == 1) {
         o->impl_->publication.store(2, std::memory_order_seq_cst);
+        reg.withdrawn.insert(o);
         withdrawn.push_back(o);
       }
   }

@@ -62,7 +62,8 @@ describe('QMotor log variables on work_cell -log FILE -qmotor', () => {
     for (let i = 1; i < q.t.length; ++i) assert.ok(q.t[i] > q.t[i - 1], 'sample times do not increase');
     // Samples at the servo rate (1 kHz), not the 60 Hz display rate.
     assert.ok((q.t.length - 1) / (q.t[q.t.length - 1] - q.t[0]) > 500, 'fewer than 500 samples a second');
-    assert.ok(Math.max(...q.v) - Math.min(...q.v) > 1e-3, 'joint 2 does not move in the plot');
+    // The arm pauses between moves: wait until the plotted joint has moved.
+    await waitInPage(page, () => { const v = window.rp.logData['puma.q[1]'].v; return Math.max(...v) - Math.min(...v) > 1e-3; });
     await page.waitForSelector('#log-plot .u-wrap canvas');
     if (shots) await page.screenshot({ path: join(shots, 'qmotor-log.png'), fullPage: true });
 
