@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <random>
 #include <thread>
 
@@ -244,10 +245,13 @@ TEST_F(ManipulatorLinkWrench, WrenchesSetFromAnotherThreadWhileTheLoopRuns) {
     for (int link = 1; link <= 6; ++link) puma.clearExternalWrench(link);
     puma.clearExternalWrench();
   });
+  // The simulated clock can run 500 cycles before the user thread is first scheduled: wait until
+  // it writes, then let the loop run while it goes on writing.
+  for (int i = 0; i < 10000 && writes.load() < 10; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_GE(writes.load(), 10);
   ASSERT_TRUE(puma.waitForCycles(500));
   done.store(true);
   user.join();
-  EXPECT_GT(writes.load(), 0);
   ASSERT_TRUE(puma.waitForCycles(2000));
   const JointVector end = puma.getJointPosition();
   // Held by the PID: 5 N pushes are far below what moves it more than a few mrad, and the
