@@ -36,11 +36,10 @@ int main(int argc, char* argv[]) {
   workpiece.setTransform(translation(0, 0.5, 0.05));
   DefaultTrajectoryGenerator<6> tragen("tragen");
   puma.setTrajectoryGenerator(tragen);
-  // Puma560 and DefaultGripper publish themselves to the Scene Viewer when constructed; objects
-  // of plain or template classes are published by the program (and withdrawn before they go,
-  // except a plain PhysicalObject, whose destructor does it).
+  // Puma560, DefaultGripper and DefaultTrajectoryGenerator publish themselves to the Scene Viewer
+  // when constructed; a plain PhysicalObject is published by the program (its destructor
+  // withdraws it).
   workpiece.publishObject();
-  tragen.publishObject();
 
   std::cout << "work_cell: objects:";
   for (const ObjectInfo& o : ObjectManager().getObjectList()) std::cout << " " << o.name << " (" << o.className << ")";
@@ -76,7 +75,6 @@ int main(int argc, char* argv[]) {
     ++cycles;
   }
   puma.clearTrajectoryGenerator();
-  tragen.withdrawObject();
   const ControlStatistics st = puma.getStatistics();
   std::cout << "work_cell: " << cycles << " cycles done; servo loop: " << st.cycles << " cycles, " << st.overruns
             << " overruns, computation p99 " << st.computationTime.p99 << " us, wake-up latency p99 "

@@ -94,8 +94,19 @@ export class ControlPanel {
     this.title.textContent = desc.panel.title;
     this.status.textContent = desc.error.code ? `Error ${desc.error.code}: ${desc.error.message}` : 'No error';
     this.status.className = `panel-status ${desc.error.code ? 'error' : ''}`;
+    // Values change often (a tuned gain comes back in the next description): the panel is
+    // rebuilt only when its fields change, and the inputs are updated in place otherwise, except
+    // the one being edited, so that nothing typed is lost.
+    const structure = JSON.stringify([desc.panel.title, desc.panel.fields.map((f) =>
+      [f.name, f.kind, f.size, f.tunable, f.stateIndex, f.min, f.max, f.label, f.unit, f.choices])]);
     if (key === this.key) return;
     this.key = key;
+    if (structure === this.structure) {
+      this.updateInputs(desc);
+      return;
+    }
+    this.structure = structure;
+    this.inputs = [];
     this.cells = [];
     const rows = [];
     for (const f of desc.panel.fields) {
@@ -113,8 +124,13 @@ export class ControlPanel {
           input.addEventListener('change', () => {
             const v = Number(input.value);
             this.conn.setParameter(this.name, f.name, v, f.kind === 'vector' ? i : undefined)
-              .catch((e) => { this.notify(`${this.name}.${f.name}: ${e.message}`); if (f.value) input.value = f.value[i]; });
+              .catch((e) => {
+                this.notify(`${this.name}.${f.name}: ${e.message}`);
+                const now = this.desc.panel.fields.find((x) => x.name === f.name);
+                if (now && now.value) input.value = now.value[i];
+              });
           });
+          this.inputs.push({ input, name: f.name, index: i });
           cell.append(input);
         }
       } else if (f.stateIndex >= 0) {
@@ -127,6 +143,13 @@ export class ControlPanel {
       rows.push(el('div', { class: 'row' }, el('label', {}, `${f.label}${f.unit ? ` [${f.unit}]` : ''}${f.tunable ? ' (tunable)' : ''}`), cell));
     }
     this.body.replaceChildren(...rows);
+  }
+  updateInputs(desc) {
+    for (const { input, name, index } of this.inputs) {
+      if (input === document.activeElement) continue;
+      const f = desc.panel.fields.find((x) => x.name === name);
+      if (f && f.value) input.value = f.value[index];
+    }
   }
   setValues(values) {
     for (const c of this.cells) {

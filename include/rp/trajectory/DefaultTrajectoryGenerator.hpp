@@ -37,11 +37,16 @@ namespace rp {
 template <int N = Dynamic>
 class DefaultTrajectoryGenerator : public QueueTrajectoryGenerator {
  public:
-  /// Creates an empty generator.
+  /// Creates an empty generator and publishes it to other threads (the Scene Viewer lists it;
+  /// see RoboticObject::publishObject()).
   /// @param[in] name  object name; empty for an automatic name
-  explicit DefaultTrajectoryGenerator(const std::string& name = "") : QueueTrajectoryGenerator(name) {}
-  /// Finishes the queue (see QueueTrajectoryGenerator), then disconnects from the manipulators.
+  explicit DefaultTrajectoryGenerator(const std::string& name = "") : QueueTrajectoryGenerator(name) {
+    publishObject();
+  }
+  /// Withdraws the generator from other threads, finishes the queue (see
+  /// QueueTrajectoryGenerator), then disconnects from the manipulators.
   ~DefaultTrajectoryGenerator() override {
+    withdrawObject();
     waitUntilDone();
     releaseFromManipulators();
   }
