@@ -3,7 +3,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <set>
 
 #include "rp/core/ObjectManager.hpp"
@@ -11,6 +10,7 @@
 #include "rp/gui/SceneViewer.hpp"
 #include "rp/gui/UrdfVisuals.hpp"
 #include "rp/manipulator/Manipulator.hpp"
+#include "rp/manipulator/UrdfManipulator.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/ManipulatorData.hpp"
 #include "rp/rt/ControlProgram.hpp"
@@ -86,17 +86,14 @@ void putTransform(std::string& out, const Transform& t) {
 
 }  // namespace
 
-// The <visual> elements of a UrdfManipulator's URDF file (its rp.cfg settings `urdf` and `tip`),
-// read once per object.
+// The <visual> elements of a UrdfManipulator's URDF file (made in code or from rp.cfg), read
+// once per object.
 void SceneState::loadVisuals(Entry& e) {
   e.urdfLoaded = true;
-  const ConfigSection* section = e.object->configSection();
-  if (!section || !section->has("urdf")) return;
-  std::string file = section->getWord("urdf");
-  if (std::filesystem::path(file).is_relative())
-    file = (std::filesystem::path(section->fileName()).parent_path() / file).string();
+  const auto* arm = dynamic_cast<const UrdfManipulator*>(e.object);
+  if (arm == nullptr || arm->getUrdfFile().empty()) return;
   try {
-    e.urdfShapes = loadUrdfVisuals(file, section->has("tip") ? section->getWord("tip") : "");
+    e.urdfShapes = loadUrdfVisuals(arm->getUrdfFile(), arm->getTip());
   } catch (const std::exception& ex) {
     e.urdfError = ex.what();
   }
@@ -155,7 +152,7 @@ json SceneState::describe(Entry& e) {
   e.frames.clear();
   if (e.physical) {
     Model3D m = e.physical->get3DModel();
-    if (e.manipulator && o.getClassName() == "UrdfManipulator") {
+    if (e.manipulator) {  // a UrdfManipulator (loadVisuals() checks) is drawn with its URDF visuals
       if (!e.urdfLoaded) loadVisuals(e);
       if (!e.urdfShapes.empty()) {
         m.shapes = e.urdfShapes;  // the URDF's own look instead of the generic links

@@ -3,6 +3,8 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include "rp/core/RoboticPlatform.hpp"
 #include "rp/core/TypeDatabase.hpp"
@@ -10,8 +12,8 @@
 namespace rp {
 
 namespace {
-std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, std::string file, std::string tip,
-                                          const Transform& base) {
+// The URDF file and tip link: rp.cfg's settings override the constructor's arguments.
+std::pair<std::string, std::string> resolve(const std::string& name, std::string file, std::string tip) {
   if (const ConfigSection* section = RoboticPlatform::getConfiguration().findSection(name)) {
     if (section->has("urdf")) {
       file = section->getWord("urdf");
@@ -20,6 +22,12 @@ std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, std::string f
     }
     if (section->has("tip")) tip = section->getWord("tip");
   }
+  return {file, tip};
+}
+
+std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, const std::string& urdfFile,
+                                          const std::string& tipLink, const Transform& base) {
+  const auto [file, tip] = resolve(name, urdfFile, tipLink);
   if (file.empty()) throw std::invalid_argument("UrdfManipulator '" + name + "': no URDF file (rp.cfg setting 'urdf')");
   UrdfOptions options;
   options.tip = tip;
@@ -35,6 +43,7 @@ std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, std::string f
 
 UrdfManipulator::UrdfManipulator(const std::string& name, const std::string& urdfFile, const std::string& tip)
     : DefaultManipulator(name, [name, urdfFile, tip](const Transform& base) { return loadFor(name, urdfFile, tip, base); }) {
+  std::tie(urdfFile_, tip_) = resolve(getName(), urdfFile, tip);
   startControlLoop();
 }
 

@@ -24,6 +24,14 @@ class UrdfManipulator : public DefaultManipulator {
   /// Declares `urdf` and `tip`.
   /// @param[out] schema  schema to add to
   static void declareSettings(SettingSchema& schema);
+  /// The URDF file the arm was loaded from (after rp.cfg's `urdf` setting, relative paths
+  /// resolved against the rp.cfg file's folder). The Scene Viewer draws its `<visual>` elements.
+  const std::string& getUrdfFile() const { return urdfFile_; }
+  /// The tip link asked for (rp.cfg's `tip` or the constructor's); empty for the default.
+  const std::string& getTip() const { return tip_; }
+
+ private:
+  std::string urdfFile_, tip_;
 };
 
 }  // namespace rp
