@@ -235,7 +235,7 @@ std::vector<std::string> ObjectManager::shutdownAllObjects(const std::string& re
     if (o->tryReference()) {
       held.push_back(ObjectReference(o));
       objects.push_back(o);
-    } else if (!reg.withdrawn.count(o)) {
+    } else if (!o->isWithdrawn()) {
       objects.push_back(o);
     }
   }

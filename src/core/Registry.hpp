@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -26,7 +25,6 @@ struct Registry {
   // thread may notify after the object it released is gone).
   std::mutex referenceMutex;
   std::condition_variable referenceCv;
-  std::set<const RoboticObject*> withdrawn;  // being destroyed (with `mutex`)
 
   // System shutdown.
   std::atomic<int> requested{0};

@@ -93,7 +93,6 @@ RoboticObject::~RoboticObject() {
   auto& reg = internal::registry();
   std::lock_guard<std::recursive_mutex> lock(reg.mutex);
   reg.objects.erase(std::remove(reg.objects.begin(), reg.objects.end(), this), reg.objects.end());
-  reg.withdrawn.erase(this);
 }
 
 void RoboticObject::declareSettings(SettingSchema&) {}
@@ -234,7 +233,6 @@ void RoboticObject::publishObject() noexcept {
         o->impl_->publication.store(1, std::memory_order_seq_cst);
       }
   }
-  reg.withdrawn.erase(this);
   impl_->publication.store(1, std::memory_order_seq_cst);
 }
 
@@ -244,11 +242,9 @@ void RoboticObject::withdrawObject() noexcept {
   {
     std::lock_guard<std::recursive_mutex> lock(reg.mutex);
     impl_->publication.store(2, std::memory_order_seq_cst);
-    reg.withdrawn.insert(this);
     for (RoboticObject* o : reg.objects)  // the objects published with this one go with it
       if (o->impl_->parent == this && o->impl_->publication.load() == 1) {
         o->impl_->publication.store(2, std::memory_order_seq_cst);
-        reg.withdrawn.insert(o);
         withdrawn.push_back(o);
       }
   }
@@ -263,6 +259,8 @@ void RoboticObject::withdrawObject() noexcept {
 }
 
 bool RoboticObject::isObjectPublished() const noexcept { return impl_->publication.load() == 1; }
+
+bool RoboticObject::isWithdrawn() const noexcept { return impl_->publication.load() == 2; }
 
 bool RoboticObject::tryReference() noexcept {
   impl_->references.fetch_add(1, std::memory_order_seq_cst);

@@ -1,11 +1,11 @@
 // LogWriter: drains the programs' ring buffers in a non-real-time thread and writes one CSV file.
 #include "rp/rt/LogWriter.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
-#include <deque>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -50,7 +50,16 @@ struct LogWriter::Impl {
   bool logging = true;  // with `mutex`: samples drained while false are not written to the file
   // The newest samples of each channel (index as `channels`), each 1 + width doubles; kept only
   // from the first getRecentSamples() call on (a log nobody plots costs nothing more).
-  std::vector<std::deque<std::vector<double>>> recent;
+  struct History {
+    std::vector<double> samples;  // kRecentSamples slots of 1 + width doubles, allocated once
+    std::size_t count = 0;        // samples stored so far; the newest is at (count - 1) % kRecentSamples
+    const double* at(std::size_t j, std::size_t stride) const {  // j-th oldest kept sample
+      const std::size_t first = count > LogWriter::kRecentSamples ? count - LogWriter::kRecentSamples : 0;
+      return &samples[((first + j) % LogWriter::kRecentSamples) * stride];
+    }
+    std::size_t size() const { return std::min(count, LogWriter::kRecentSamples); }
+  };
+  std::vector<History> recent;
   bool keepRecent = false;
 
   // With `mutex` held: moves every available sample into `staging`, then writes the rows no
@@ -60,9 +69,10 @@ struct LogWriter::Impl {
       auto& c = channels[k];
       while (const double* s = c->front()) {
         if (keepRecent) {
-          auto& history = recent[k];
-          if (history.size() >= LogWriter::kRecentSamples) history.pop_front();
-          history.emplace_back(s, s + c->width + 1);
+          History& history = recent[k];
+          const std::size_t stride = c->width + 1;
+          if (history.samples.empty()) history.samples.resize(LogWriter::kRecentSamples * stride);
+          std::copy(s, s + stride, &history.samples[(history.count++ % LogWriter::kRecentSamples) * stride]);
         }
         if (!logging) {  // stopped: the sample is only kept for the plots
           c->lastTime = s[0];
@@ -189,12 +199,13 @@ std::vector<LogSeries> LogWriter::getRecentSamples(const std::vector<std::string
         if (c->columns[i] != name) continue;
         found = true;
         const auto& history = impl_->recent[k];
+        const std::size_t stride = c->width + 1, kept = history.size();
         // Newest samples after `afterTime`, oldest first.
-        std::size_t first = history.size();
-        while (first > 0 && history[first - 1][0] > afterTime && history.size() - first < maxSamples) --first;
-        for (std::size_t j = first; j < history.size(); ++j) {
-          series.time.push_back(history[j][0]);
-          series.value.push_back(history[j][i + 1]);
+        std::size_t first = kept;
+        while (first > 0 && history.at(first - 1, stride)[0] > afterTime && kept - first < maxSamples) --first;
+        for (std::size_t j = first; j < kept; ++j) {
+          series.time.push_back(history.at(j, stride)[0]);
+          series.value.push_back(history.at(j, stride)[i + 1]);
         }
       }
     }

@@ -109,22 +109,24 @@ bool tryQuintic(const Setpoint& a, const Setpoint& b, double D, const JointVecto
   return ok;
 }
 
-// Shortest duration in (0, longest] for which `ok` holds: a scan from short to long, then
-// bisection down towards the last failure. -1 if none.
+constexpr int kScan = 48;  // points of the scans below
+
+// Scans `ok` at kScan evenly spaced points from `first` to `last` (either way round) and returns
+// the first point where it holds, refined by bisection towards `before` (the scan's starting side)
+// or the last point where it failed, to 1e-9 relative; -1 if it holds at no point.
 template <typename Ok>
-double shortestFeasible(double longest, Ok ok) {
-  constexpr int kScan = 48;
-  double bad = 0, good = -1;
-  for (int k = 1; k <= kScan; ++k) {
-    const double D = longest * k / kScan;
-    if (ok(D)) {
-      good = D;
+double firstFeasible(double before, double first, double last, Ok ok) {
+  double bad = before, good = -1;
+  for (int k = 0; k < kScan; ++k) {
+    const double x = first + (last - first) * k / (kScan - 1);
+    if (ok(x)) {
+      good = x;
       break;
     }
-    bad = D;
+    bad = x;
   }
   if (good < 0) return -1;
-  for (int it = 0; it < 30 && good - bad > 1e-9 * good; ++it) {
+  for (int it = 0; it < 30 && std::abs(good - bad) > 1e-9 * good; ++it) {
     const double mid = 0.5 * (bad + good);
     if (ok(mid)) good = mid;
     else bad = mid;
@@ -234,23 +236,10 @@ bool planBlend(const SegmentPlan& from, const SegmentPlan& to, const JointVector
     return lines ? linesKeepLimits(from, to, overlap, vmax, amax, jmax)
                  : sampledKeepLimits(from, to, overlap, vmax, amax, jmax);
   };
-  double overlap = -1, bad = -1;
-  constexpr int kScan = 48;
-  for (int k = 0; k < kScan; ++k) {  // from the longest down
-    const double o = longest * (1 - static_cast<double>(k) / kScan);
-    if (o < kShortest) break;
-    if (overlapOk(o)) {
-      overlap = o;
-      break;
-    }
-    bad = o;
-  }
+  // The longest overlap: scanned from `longest` down, then bisected up.
+  const double overlap =
+      firstFeasible(longest, longest, longest / kScan, [&](double o) { return o >= kShortest && overlapOk(o); });
   if (overlap > 0) {
-    for (int it = 0; bad > 0 && it < 30 && bad - overlap > 1e-9; ++it) {  // bisect up
-      const double mid = 0.5 * (overlap + bad);
-      if (overlapOk(mid)) overlap = mid;
-      else bad = mid;
-    }
     blend.from = &from;
     blend.to = &to;
     blend.fromStart = from.duration - overlap;
@@ -266,7 +255,9 @@ bool planBlend(const SegmentPlan& from, const SegmentPlan& to, const JointVector
   to.evaluate(to.entryTime, b);
   for (auto& c : blend.coefficients) c = JointVector(n);
   constexpr double kLongestQuintic = 3;  // times stopping (Blend.hpp)
-  const double D = shortestFeasible(kLongestQuintic * stopping, [&](double d) { return tryQuintic(a, b, d, vmax, amax, jmax, blend); });
+  const double longestQuintic = kLongestQuintic * stopping;  // the shortest: scanned up, bisected down
+  const double D = firstFeasible(0, longestQuintic / kScan, longestQuintic,
+                                 [&](double d) { return tryQuintic(a, b, d, vmax, amax, jmax, blend); });
   if (D < 0 || !tryQuintic(a, b, D, vmax, amax, jmax, blend)) return false;
   blend.fromStart = from.exitTime;
   blend.duration = blend.exitTime = D;

@@ -32,6 +32,10 @@ struct Line {
   }
 };
 
+// Whether a Jacobian with these singular values (largest first) has lost rank: fewer than six,
+// or the smallest below 1e-4 of the largest. No straight line is defined there.
+bool rankDeficient(const Eigen::VectorXd& sv) { return sv.size() < 6 || sv(5) < 1e-4 * std::max(1.0, sv(0)); }
+
 std::string point(const Transform& T) {
   std::ostringstream s;
   s.precision(4);
@@ -78,7 +82,7 @@ bool sampleNodes(const ManipulatorModel& model, ManipulatorData& data, const Lin
     const Eigen::MatrixXd J = jacobian(model, data, q[k], ReferenceFrame::Base);
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinU | Eigen::ComputeThinV);
     const Eigen::VectorXd sv = svd.singularValues();
-    if (sv.size() < 6 || sv(5) < 1e-4 * std::max(1.0, sv(0))) {  // isSingular()
+    if (rankDeficient(sv)) {
       throw std::invalid_argument(who + "the straight line passes through a singularity at " + point(line.at(k * h)));
     }
     Eigen::VectorXd d = svd.solve(line.twist);
@@ -119,15 +123,12 @@ double deviation(const ManipulatorModel& model, ManipulatorData& data, const Lin
   return worst;
 }
 
-constexpr double kSingular = 1e-4;
-
 }  // namespace
 
 bool isSingular(const ManipulatorModel& model, const JointVector& q) {
   ManipulatorData data(model);
   const Eigen::MatrixXd J = jacobian(model, data, q, ReferenceFrame::Base);
-  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(J).singularValues();
-  return sv.size() < 6 || sv(5) < kSingular * std::max(1.0, sv(0));
+  return rankDeficient(Eigen::JacobiSVD<Eigen::MatrixXd>(J).singularValues());
 }
 
 SegmentPlan planCartesianLine(const ManipulatorModel& model, const JointVector& qStart, const Transform& goal,

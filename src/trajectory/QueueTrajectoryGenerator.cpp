@@ -261,11 +261,7 @@ CartesianLimits QueueTrajectoryGenerator::getCartesianLimits() const {
 }
 
 void QueueTrajectoryGenerator::setJointBlendRadius(double radians) {
-  if (!(radians >= 0) || !std::isfinite(radians)) {
-    throw std::invalid_argument(getName() + ": the joint blend radius must be finite and >= 0 rad");
-  }
-  std::lock_guard<std::mutex> lock(producerMutex_);
-  jointBlendRadius_ = radians;
+  setRadius(jointBlendRadius_, radians, "joint blend radius", "rad");
 }
 
 double QueueTrajectoryGenerator::getJointBlendRadius() const {
@@ -274,11 +270,15 @@ double QueueTrajectoryGenerator::getJointBlendRadius() const {
 }
 
 void QueueTrajectoryGenerator::setCartesianBlendRadius(double metres) {
-  if (!(metres >= 0) || !std::isfinite(metres)) {
-    throw std::invalid_argument(getName() + ": the Cartesian blend radius must be finite and >= 0 m");
+  setRadius(cartesianBlendRadius_, metres, "Cartesian blend radius", "m");
+}
+
+void QueueTrajectoryGenerator::setRadius(double& radius, double value, const char* what, const char* unit) {
+  if (!(value >= 0) || !std::isfinite(value)) {
+    throw std::invalid_argument(getName() + ": the " + what + " must be finite and >= 0 " + unit);
   }
   std::lock_guard<std::mutex> lock(producerMutex_);
-  cartesianBlendRadius_ = metres;
+  radius = value;
 }
 
 double QueueTrajectoryGenerator::getCartesianBlendRadius() const {

@@ -1,17 +1,17 @@
 // Straight-line Cartesian motion and blending through the queue, evaluated at 1 kHz on a paused
 // simulated clock (the test calls getCurrentSetpoint() itself), and executed by simulated arms.
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include <cstdio>
-#include <vector>
-
-#include <Eigen/Geometry>
-
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <thread>
+#include <vector>
 
+#include "../manipulator/SimulatedArmTest.hpp"
 #include "AllocationCounter.hpp"
 #include "rp/RoboticPlatform.hpp"
 
@@ -22,21 +22,24 @@ constexpr double kDeg = std::numbers::pi / 180;
 // A Puma pose in the middle of the work space, gripper pointing down (as in Figure 21).
 const Transform kWorkPose = translation(0.5, 0.2, 0.3) * xRotation(std::numbers::pi);
 
-class CartesianMotionTest : public ::testing::Test {
+class CartesianMotionTest : public test::SimulatedArmTest {
  protected:
-  void SetUp() override {
-    RoboticPlatform::setConfiguration(Configuration());
-    RoboticPlatform::setSimulationModeOn();
-    RoboticPlatform::useSimulatedClock();
-    ObjectManager::resetShutdown();
-  }
-  SimulatedClock& clock() { return dynamic_cast<SimulatedClock&>(RoboticPlatform::getDefaultClock()); }
+  SimulatedClock& clock() { return test::simClock(); }
   // Pauses the clock once the arm's loop has run its first cycle; the test then drives time.
   void takeOver(DefaultManipulator& m) {
     clock().pause();
     while (m.getCycleCount() < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
 };
+
+// Three Puma joint targets [deg] around a gentle corner: every joint keeps its direction.
+std::array<Vector<6>, 3> gentleCorner() {
+  std::array<Vector<6>, 3> p;
+  p[0] = 0, 30, -120, 0, 30, 0;
+  p[1] = 40, 50, -100, 30, 60, 20;
+  p[2] = 70, 55, -70, 40, 80, 60;
+  return p;
+}
 
 struct Sampled {
   std::vector<Setpoint> setpoints;
@@ -213,10 +216,7 @@ TEST_F(CartesianMotionTest, JointBlendPassesNearTheViaPointWithoutStopping) {
   Puma560 puma;
   takeOver(puma);
   const ManipulatorModel& model = puma.getModel();
-  Vector<6> a, via, b;
-  a = 0, 30, -120, 0, 30, 0;
-  via = 40, 50, -100, 30, 60, 20;
-  b = 70, 55, -70, 40, 80, 60;  // a gentle corner: every joint keeps its direction
+  const auto [a, via, b] = gentleCorner();
   double unblendedTime = 0, blendedTime = 0;
   for (double radius : {0.0, 0.3}) {
     DefaultTrajectoryGenerator<6> tragen;
@@ -290,10 +290,7 @@ TEST_F(CartesianMotionTest, ABlendQueuedTooLateIsSkippedAndTheArmStopsAtTheViaPo
   const ManipulatorModel& model = puma.getModel();
   DefaultTrajectoryGenerator<6> tragen;
   puma.setTrajectoryGenerator(tragen);
-  Vector<6> a, via, b;
-  a = 0, 30, -120, 0, 30, 0;
-  via = 40, 50, -100, 30, 60, 20;
-  b = 70, 55, -70, 40, 80, 60;
+  const auto [a, via, b] = gentleCorner();
   tragen.move(a);
   run(tragen, model, 6, 100);
   tragen.setJointBlendRadius(0.3);

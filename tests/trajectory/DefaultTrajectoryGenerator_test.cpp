@@ -1,13 +1,14 @@
 // DefaultTrajectoryGenerator driving simulated arms on the simulated clock.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <numbers>
 #include <random>
-#include <vector>
 #include <thread>
+#include <vector>
 
+#include "../manipulator/SimulatedArmTest.hpp"
 #include "AllocationCounter.hpp"
 #include "rp/RoboticPlatform.hpp"
 
@@ -16,15 +17,7 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180;
 
-class TrajectoryTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    RoboticPlatform::setConfiguration(Configuration());
-    RoboticPlatform::setSimulationModeOn();
-    RoboticPlatform::useSimulatedClock();
-    ObjectManager::resetShutdown();
-  }
-};
+using TrajectoryTest = test::SimulatedArmTest;
 
 TEST_F(TrajectoryTest, JointMovesInDegreesReachTheirTargets) {
   Puma560 puma;

@@ -257,6 +257,7 @@ class RoboticObject {
   friend class ObjectManager;
   friend class ObjectReference;
   bool tryReference() noexcept;  // takes a reference if published
+  bool isWithdrawn() const noexcept;  // withdrawn: being destroyed
   void releaseReference() noexcept;
 
   struct Impl;

@@ -145,6 +145,7 @@ class QueueTrajectoryGenerator : public TrajectoryGenerator {
   void waitForRoom(int slots);
   void publish(std::uint64_t index, internal::SegmentPlan&& plan);
   double startOf(Slot& slot, double time, double offset);
+  void setRadius(double& radius, double value, const char* what, const char* unit);
 
   std::unique_ptr<std::array<Slot, kCapacity>> ring_;
   std::atomic<std::uint64_t> head_{0}, tail_{0};  // segments [head, tail) are not finished
