@@ -45,6 +45,10 @@ int main(int argc, char* argv[]) {
   tragen.moveTo(translation(0.3, 0.4, 0.2) * down);
   tragen.stop(0.5);
 
+  if (ObjectManager::isShutdownRequested()) {  // a fault, an emergency stop or Ctrl-C ended the motion
+    std::cerr << "blended_motion: stopped by a system shutdown: " << ObjectManager::getShutdownReason() << std::endl;
+    return RoboticPlatform::kExitAfterShutdown;
+  }
   std::cout << "blended_motion: " << tragen.getBlendCount() << " via points blended, end-effector at "
             << RowVector<3>(getPosition(puma.getEndEffectorTransform()).transpose()) << std::endl;
   return 0;

@@ -13,7 +13,8 @@
 //   of reach of a Puma 560 at the origin with the gripper pointing down (its shoulder is 0.67 m
 //   up, the arm reaches 0.86 m, and joint 5 turns at most 100 degrees); here they are
 //   (0, 0.5, 0.2), (0.5, 0.5, 0.3) and (0.6, 0.2, 0.2) m;
-// - a line at the end says that the task is done.
+// - a line at the end says that the task is done, or that a system shutdown (a fault, Ctrl-C)
+//   stopped it (then the exit status is not 0).
 #include "RoboticPlatform.hpp"
 
 #include <iostream>
@@ -50,6 +51,10 @@ int main(int argc, char* argv[]) {
   gripper.open();
   tragen.stop(1);
 
+  if (ObjectManager::isShutdownRequested()) {  // a fault, an emergency stop or Ctrl-C ended the motion
+    std::cerr << "pick_and_place: stopped by a system shutdown: " << ObjectManager::getShutdownReason() << std::endl;
+    return RoboticPlatform::kExitAfterShutdown;
+  }
   std::cout << "pick_and_place: done, end-effector at " << RowVector<3>(getPosition(puma.getEndEffectorTransform()).transpose())
             << std::endl;
   return 0;

@@ -55,6 +55,10 @@ int main(int argc, char* argv[]) {
     }
     std::this_thread::sleep_for(std::chrono::microseconds(100));
   }
+  if (ObjectManager::isShutdownRequested()) {  // a fault, an emergency stop or Ctrl-C ended the motion
+    std::cerr << "sim_vs_real: stopped by a system shutdown: " << ObjectManager::getShutdownReason() << std::endl;
+    return RoboticPlatform::kExitAfterShutdown;
+  }
   std::cout << "sim_vs_real: largest joint-position difference between the arms: " << largest << " rad" << std::endl;
   return puma.getErrorCode() == 0 && pumaSimulated.getErrorCode() == 0 ? 0 : 1;
 }

@@ -109,5 +109,9 @@ int main(int argc, char* argv[]) {
   std::cout << "final end-effector position: " << t(0, 3) << " " << t(1, 3) << " " << t(2, 3) << std::endl;
   puma.clearExternalWrench();
   if (simClock != nullptr) simClock->resume();
+  if (ObjectManager::isShutdownRequested()) {  // a fault, an emergency stop or Ctrl-C ended the motion
+    std::cerr << "virtual_walls: stopped by a system shutdown: " << ObjectManager::getShutdownReason() << std::endl;
+    return RoboticPlatform::kExitAfterShutdown;
+  }
   return puma.getErrorCode() == 0 ? 0 : 1;
 }

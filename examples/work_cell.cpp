@@ -79,5 +79,9 @@ int main(int argc, char* argv[]) {
   std::cout << "work_cell: " << cycles << " cycles done; servo loop: " << st.cycles << " cycles, " << st.overruns
             << " overruns, computation p99 " << st.computationTime.p99 << " us, wake-up latency p99 "
             << st.wakeupLatency.p99 << " us, max " << st.wakeupLatency.max << " us" << std::endl;
+  if (ObjectManager::isShutdownRequested()) {  // a fault, an emergency stop or Ctrl-C ended the motion
+    std::cerr << "work_cell: stopped by a system shutdown: " << ObjectManager::getShutdownReason() << std::endl;
+    return RoboticPlatform::kExitAfterShutdown;
+  }
   return 0;
 }

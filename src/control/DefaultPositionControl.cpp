@@ -57,7 +57,10 @@ void DefaultPositionControl::setGains(const JointVector& kp, const JointVector& 
   gainsSet_ = true;
 }
 
-void DefaultPositionControl::activate() { integral_.setZero(); }
+void DefaultPositionControl::activate() {
+  integral_.setZero();
+  if (d_manipulator != nullptr) period_ = d_manipulator->getServoPeriod();  // the rate may have changed since attach()
+}
 
 void DefaultPositionControl::calculate() {
   Manipulator& m = *d_manipulator;

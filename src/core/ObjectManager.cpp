@@ -62,7 +62,10 @@ void watcher() {
       reg.done = true;
     }
     reg.doneCv.notify_all();
-    if (int sig = reg.signalNumber.load()) _exit(128 + sig);
+    if (int sig = reg.signalNumber.load()) {
+      std::fflush(nullptr);
+      _exit(128 + sig);
+    }
   }
 }
 

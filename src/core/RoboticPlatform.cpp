@@ -2,6 +2,7 @@
 #include "rp/core/RoboticPlatform.hpp"
 
 #include <signal.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cstdio>
@@ -55,7 +56,22 @@ void onSignal(int sig) {
   ObjectManager::requestSystemShutdown(sig == SIGINT ? "SIGINT received" : "SIGTERM received");
 }
 
-void atExit() { RoboticPlatform::finish(); }
+// The last exit handler init() registers runs first at exit: it completes a shutdown in
+// progress (or holds and powers off the arms still running), closes the log, and sets the exit
+// status: 128 + the signal after SIGINT or SIGTERM, kExitAfterShutdown after any other system
+// shutdown (a fault, an emergency stop), else the program's own.
+void atExit() {
+  RoboticPlatform::finish();
+  auto& reg = internal::registry();
+  std::fflush(nullptr);
+  if (const int sig = reg.signalNumber.load()) _exit(128 + sig);
+  if (ObjectManager::isShutdownRequested()) {
+    std::fprintf(stderr, "rp: the program ends after a system shutdown (%s): exit status %d\n",
+                 ObjectManager::getShutdownReason().c_str(), RoboticPlatform::kExitAfterShutdown);
+    std::fflush(nullptr);
+    _exit(RoboticPlatform::kExitAfterShutdown);
+  }
+}
 
 }  // namespace
 
@@ -185,6 +201,9 @@ void RoboticPlatform::init(int& argc, char** argv, const std::string& programUsa
   internal::ensureShutdownWatcher();
   signal(SIGINT, onSignal);
   signal(SIGTERM, onSignal);
+  // A closed stdout (`program | head -1`) must not kill the control program: writes to it fail
+  // with EPIPE instead.
+  signal(SIGPIPE, SIG_IGN);
   std::atexit(atExit);
   if (!getLogFileName().empty()) {
     try {
@@ -309,6 +328,17 @@ void RoboticPlatform::setGuiStarter(std::function<void()> starter) {
 }
 
 void RoboticPlatform::finish() {
+  auto& reg = internal::registry();
+  if (ObjectManager::isShutdownRequested()) {
+    // A shutdown in progress (a signal, a fault) is carried out by the manager's thread: the
+    // program ends only once it is complete (the arms at rest, powered off, the log closed).
+    ObjectManager::waitForShutdown(reg.timeoutSeconds.load() + 5.0);
+  } else {
+    // The arms still running (objects the program did not destroy) are held until at rest and
+    // powered off, as in a shutdown.
+    const auto pending = ObjectManager().shutdownAllObjects("the program ends");
+    for (const auto& name : pending) std::fprintf(stderr, "rp: at exit: %s did not complete its shutdown\n", name.c_str());
+  }
   ObjectManager().deleteAllObjects();
   ControlProgram::stopAll();
   LogWriter::closePlatformWriter();

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <mutex>
 #include <stdexcept>
@@ -63,6 +64,18 @@ namespace {
 constexpr double kRestVelocity = 1e-3;  // [rad/s] below which the arm counts as at rest
 constexpr double kRestDuration = 0.05;  // [s] at rest before the power goes off in a shutdown
 constexpr double kShutdownTimeout = 3.0;  // [s] longest damped hold
+constexpr int kMaxCatchUpSteps = 1000;    // longest stall the simulation integrates, in periods
+
+bool allFinite(const JointVector& v) {
+  for (int i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v(i))) return false;
+  return true;
+}
+int firstNonFinite(const JointVector& v) {
+  for (int i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v(i))) return i;
+  return -1;
+}
 }  // namespace
 
 DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFactory& modelFactory)
@@ -111,6 +124,8 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   registerLogVariable("qddes", setpoint_.velocity.data(), static_cast<std::size_t>(n), "rad/s");
   registerLogVariable("qdddes", setpoint_.acceleration.data(), static_cast<std::size_t>(n), "rad/s^2");
   registerLogVariable("tau", tau_.data(), static_cast<std::size_t>(n), "N m");
+  registerLogVariable("saturated", saturatedJoints_, "joints");
+  registerLogVariable("missed", missedCycles_, "cycles");
   registerParameter("kp", defaultControl_->getKp().data(), static_cast<std::size_t>(n), 0, 1e7, "N m/rad",
                     "proportional gains of the default position control");
   registerParameter("kd", defaultControl_->getKd().data(), static_cast<std::size_t>(n), 0, 1e6, "N m s/rad",
@@ -123,6 +138,7 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
 }
 
 DefaultManipulator::~DefaultManipulator() {
+  holdUntilSafe();
   stopControlLoop();
   if (TrajectoryGenerator* g = generator_.exchange(nullptr)) {
     disconnectGenerator(*g);
@@ -272,10 +288,28 @@ void DefaultManipulator::applyExternalWrench(int link, const Vector<3>& point, c
 }
 
 void DefaultManipulator::startShutdown() {
-  RoboticObject::startShutdown();
+  // Not RoboticObject::startShutdown(): that stops the loop, and the loop must run the damped
+  // hold until the arm is at rest. The loop then switches the power off (phase 2); the system
+  // shutdown stops it after that.
   int expected = 0;
   shutdownPhase_.compare_exchange_strong(expected, 1);
-  if (!isRunning()) shutdownPhase_.store(2);
+  if (!isRunning()) {
+    if (board_) writeOutputsOff();
+    shutdownPhase_.store(2);
+  }
+}
+
+void DefaultManipulator::holdUntilSafe() {
+  if (!isRunning()) return;
+  // A loop stopped by runCycles() on a paused simulated clock cannot run the hold: nothing
+  // moves while the simulated clock stands still, and the brakes go on when the loop ends.
+  pauseAtCycle_.store(0, std::memory_order_relaxed);
+  if (auto* simulated = dynamic_cast<SimulatedClock*>(&getClock()); simulated != nullptr && simulated->isPaused()) return;
+  int expected = 0;
+  shutdownPhase_.compare_exchange_strong(expected, 1);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kShutdownTimeout + 2.0);
+  while (isRunning() && shutdownPhase_.load() != 2 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
 }
 
 bool DefaultManipulator::isShutdownComplete() const { return shutdownPhase_.load() == 2; }
@@ -330,12 +364,20 @@ void DefaultManipulator::writeHardware() {
   if (board_->writeDigitalOutput(0, power_) != IoStatus::kOk) ioFailure("switching the amplifiers", 0);
 }
 
+void DefaultManipulator::writeOutputsOff() noexcept {
+  // Every output is written even if one fails: the amplifiers off first, then 0 V.
+  (void)board_->writeDigitalOutput(0, false);
+  for (int i = 0; i < model_->getNumberOfJoints(); ++i) (void)board_->writeAnalogOutput(i, 0.0);
+}
+
 void DefaultManipulator::ioFailure(const char* what, int line) {
   // Real-time safe: formats into a member buffer. The arm cannot be controlled: shut down.
   std::snprintf(errorBuffer_, sizeof errorBuffer_, "%.60s: hardware failure %.40s (line %d): %.120s", nameBuffer_, what, line,
                 board_->lastError());
   setError(2, errorBuffer_);
   power_ = false;
+  tau_.setZero();
+  writeOutputsOff();  // best effort: the amplifiers off, 0 V
   if (shutdownPhase_.load() != 2) shutdownPhase_.store(2);
   requestSystemShutdown(errorBuffer_);
 }
@@ -343,14 +385,24 @@ void DefaultManipulator::ioFailure(const char* what, int line) {
 void DefaultManipulator::enterControl() {
   servoThread_.store(std::this_thread::get_id());
   simulatedClock_ = dynamic_cast<SimulatedClock*>(&getClock());
+  lastCycleTime_ = -1;
+  // The rate is final now (rp.cfg's qmotorConfig may have set it after construction): the
+  // velocity filter takes this period (the servo controls take it in activate()).
+  if (board_ && velocity_->getSamplePeriod() != getPeriod()) {
+    velocity_ = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
+    (void)velocity_->differentiate(q_);
+  }
   power_ = powerRequested_.load();
   sim_->setBrakes(!power_);
 }
 
 void DefaultManipulator::exitControl() {
-  // The loop is gone: a shutdown in progress cannot finish its damped hold, so the brakes go on.
-  sim_->setBrakes(true);
+  // The loop ends, however it ends: the amplifiers go off with 0 V on every joint (hardware),
+  // the brakes go on (simulation and hardware alike), and a hold in progress is over.
   power_ = false;
+  tau_.setZero();
+  if (board_) writeOutputsOff();
+  sim_->setBrakes(true);
   publish();
   if (shutdownPhase_.load() == 1) shutdownPhase_.store(2);
 }
@@ -361,7 +413,7 @@ void DefaultManipulator::control() {
   const int n = model_->getNumberOfJoints();
 
   // 1. Commands from other threads, then the joints.
-  const int phase = shutdownPhase_.load(std::memory_order_acquire);
+  int phase = shutdownPhase_.load(std::memory_order_acquire);
   const bool wantPower = powerRequested_.load(std::memory_order_relaxed) && phase == 0;
   if (wantPower != power_ && phase == 0) {
     power_ = wantPower;
@@ -389,6 +441,15 @@ void DefaultManipulator::control() {
     q_ = sim_->getPosition();
     qd_ = sim_->getVelocity();
   }
+  missedCycles_ = static_cast<double>(getMissedCycleCount());
+  // A joint reading that is not a number cannot be controlled: power off at once (no damped
+  // hold can be computed from it).
+  if (const int bad = std::max(firstNonFinite(q_), firstNonFinite(qd_)); bad >= 0) {
+    std::snprintf(errorBuffer_, sizeof errorBuffer_, "%.60s: joint %d reading is not a number (position %g, velocity %g)",
+                  nameBuffer_, bad + 1, q_(bad), qd_(bad));
+    powerOffNow();
+    return finishCycle(t, dt);
+  }
 
   // 2. The setpoint: the trajectory generator's, or hold.
   const bool zeroG = zeroGravity_.load(std::memory_order_relaxed);
@@ -400,19 +461,31 @@ void DefaultManipulator::control() {
   if (generator != nullptr && power_ && !zeroG && phase == 0) {
     executing_.store(generator, std::memory_order_seq_cst);
     // Re-check: a generator being released is not called any more.
-    if (generator_.load(std::memory_order_seq_cst) == generator && generator->getCurrentSetpoint(t, setpoint_)) {
-      hold_ = setpoint_.position;
+    try {
+      if (generator_.load(std::memory_order_seq_cst) == generator && generator->getCurrentSetpoint(t, setpoint_)) {
+        if (allFinite(setpoint_.position) && allFinite(setpoint_.velocity) && allFinite(setpoint_.acceleration)) {
+          hold_ = setpoint_.position;
+        } else {
+          fault("the trajectory generator gave a setpoint that is not a number");
+        }
+      }
+    } catch (const std::exception& e) {
+      fault("the trajectory generator threw: %.150s", e.what());
+    } catch (...) {
+      fault("the trajectory generator threw an exception");
     }
     executing_.store(nullptr, std::memory_order_release);
+    if (shutdownPhase_.load(std::memory_order_relaxed) != 0) {  // faulted: hold where the arm is
+      setpoint_.position = hold_;
+      setpoint_.velocity.setZero();
+      setpoint_.acceleration.setZero();
+    }
   }
 
   // 3. Servo control.
+  phase = shutdownPhase_.load(std::memory_order_acquire);
   tau_.setZero();
-  const bool gravityOn = gravityCompensation_.load(std::memory_order_relaxed);
-  if (phase != 0) {
-    // Damped hold: velocity damping with the default derivative gains, plus gravity.
-    tau_ = -(defaultControl_->getKd().cwiseProduct(qd_));
-  } else if (!zeroG) {
+  if (phase == 0 && !zeroG) {
     ServoControl* control = servoControl_.load(std::memory_order_acquire);
     executing_.store(control, std::memory_order_seq_cst);
     if (servoControl_.load(std::memory_order_seq_cst) != control) {
@@ -420,19 +493,40 @@ void DefaultManipulator::control() {
       control = servoControl_.load(std::memory_order_acquire);
       executing_.store(control, std::memory_order_seq_cst);
     }
-    if (control != activeControl_) {
-      activeControl_ = control;
-      control->activate();
+    try {
+      if (control != activeControl_) {
+        activeControl_ = control;
+        control->activate();
+      }
+      control->calculate();
+      if (const int bad = firstNonFinite(tau_); bad >= 0)
+        fault("the servo control gave joint %d a torque that is not a number (%g)", bad + 1, tau_(bad));
+    } catch (const std::exception& e) {
+      fault("the servo control threw: %.150s", e.what());
+    } catch (...) {
+      fault("the servo control threw an exception");
     }
-    control->calculate();
     executing_.store(nullptr, std::memory_order_release);
   }
-  if (gravityOn || zeroG || phase != 0) {
+  phase = shutdownPhase_.load(std::memory_order_acquire);
+  if (phase != 0) {
+    holdTorque();
+  } else if (gravityCompensation_.load(std::memory_order_relaxed) || zeroG) {
     gravityTorque(*model_, *data_, q_, gravity_);
     tau_ += gravity_;
   }
 
-  // 4. Limits.
+  // 4. The command is saturated at the torque limits (control and gravity together), then the
+  // position and velocity limits are checked.
+  saturatedJoints_ = 0;
+  for (int i = 0; i < n; ++i) {
+    const double limit = model_->getTorqueLimit()(i);
+    if (std::abs(tau_(i)) > limit) {
+      tau_(i) = std::copysign(limit, tau_(i));
+      saturatedJoints_ += 1;
+    }
+  }
+  if (saturatedJoints_ > 0 && power_) saturatedCycles_.fetch_add(1, std::memory_order_relaxed);
   if (power_ && phase == 0) checkLimits();
 
   // Shutdown: at rest for a while (or timed out), then power off.
@@ -445,14 +539,23 @@ void DefaultManipulator::control() {
       shutdownPhase_.store(2, std::memory_order_release);
     }
   }
+  finishCycle(t, dt);
+}
 
-  // 5. Output: no torque without power; the simulation integrates the dynamics.
+void DefaultManipulator::finishCycle(double t, double dt) {
+  // 5. Output: no torque without power; the simulation integrates the dynamics over the time
+  // that really passed since the last cycle (on the real clock a stall skips deadlines, and a
+  // real arm moves on under the last torque meanwhile), in steps of one period.
   if (!power_) tau_.setZero();
   if (board_) {
     writeHardware();
   } else {
-    sim_->step(tau_, dt);
+    int steps = 1;
+    if (simulatedClock_ == nullptr && lastCycleTime_ >= 0 && t - lastCycleTime_ > 1.5 * dt)
+      steps = std::min(kMaxCatchUpSteps, static_cast<int>(std::lround((t - lastCycleTime_) / dt)));
+    for (int k = 0; k < steps; ++k) sim_->step(tau_, dt);
   }
+  lastCycleTime_ = t;
 
   // 6. State for other threads (log samples are taken by the ControlProgram after control()).
   publish();
@@ -469,10 +572,6 @@ void DefaultManipulator::control() {
 void DefaultManipulator::checkLimits() {
   const int n = model_->getNumberOfJoints();
   for (int i = 0; i < n; ++i) {
-    if (std::abs(tau_(i)) > model_->getTorqueLimit()(i)) {
-      violation("torque", i, tau_(i), std::copysign(model_->getTorqueLimit()(i), tau_(i)), "N m");
-      return;
-    }
     if (q_(i) < model_->getPositionMin()(i)) {
       violation("position", i, q_(i), model_->getPositionMin()(i), "rad");
       return;
@@ -489,15 +588,40 @@ void DefaultManipulator::checkLimits() {
 }
 
 void DefaultManipulator::violation(const char* what, int joint, double value, double limit, const char* unit) {
-  // Real-time safe: formats into a member buffer, never allocates.
-  std::snprintf(errorBuffer_, sizeof errorBuffer_, "%s: joint %d %s %.6g %s exceeds the limit %.6g %s", nameBuffer_,
-                joint + 1, what, value, unit, limit, unit);
+  fault("joint %d %s %.6g %s exceeds the limit %.6g %s", joint + 1, what, value, unit, limit, unit);
+  // Damped hold from this very cycle.
+  holdTorque();
+  for (int i = 0; i < tau_.size(); ++i)
+    tau_(i) = std::clamp(tau_(i), -model_->getTorqueLimit()(i), model_->getTorqueLimit()(i));
+}
+
+void DefaultManipulator::fault(const char* format, ...) noexcept {
+  // Real-time safe: formats into member buffers, never allocates. The first fault wins.
+  if (shutdownPhase_.load(std::memory_order_relaxed) != 0) return;
+  char detail[200];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(detail, sizeof detail, format, args);
+  va_end(args);
+  std::snprintf(errorBuffer_, sizeof errorBuffer_, "%.60s: %.190s", nameBuffer_, detail);
   setError(1, errorBuffer_);
   shutdownPhase_.store(1, std::memory_order_release);
-  // Damped hold from this very cycle.
+  requestSystemShutdown(errorBuffer_);
+}
+
+void DefaultManipulator::holdTorque() {
+  // Velocity damping with the default derivative gains, plus gravity; within the torque limits.
   tau_ = -(defaultControl_->getKd().cwiseProduct(qd_));
   gravityTorque(*model_, *data_, q_, gravity_);
   tau_ += gravity_;
+}
+
+void DefaultManipulator::powerOffNow() noexcept {
+  setError(2, errorBuffer_);
+  power_ = false;
+  tau_.setZero();
+  sim_->setBrakes(true);
+  shutdownPhase_.store(2, std::memory_order_release);
   requestSystemShutdown(errorBuffer_);
 }
 

@@ -12,6 +12,7 @@ ManipulatorSimulation::ManipulatorSimulation(const ManipulatorModel& model) : mo
   const int n = model.getNumberOfJoints();
   q_ = model.getHomePosition();
   for (JointVector* v : {&qd_, &qdd_, &tauTotal_, &tauExt_, &coulombPos_, &coulombNeg_}) v->setZero(n);
+  brakeTorque_ = model.getTorqueLimit();
   for (int i = 0; i < n; ++i) {
     const LinkParameters& l = model.getLink(i);
     coulombPos_(i) = std::abs(l.gearRatio) * l.coulombFrictionPositive;
@@ -28,15 +29,19 @@ void ManipulatorSimulation::setState(const JointVector& q, const JointVector& qd
   qdd_.setZero();
 }
 
+void ManipulatorSimulation::setBrakeTorque(const JointVector& torque) {
+  if (torque.size() != model_.getNumberOfJoints())
+    throw std::invalid_argument("ManipulatorSimulation::setBrakeTorque: " + std::to_string(torque.size()) +
+                                " torques for " + std::to_string(model_.getNumberOfJoints()) + " joints");
+  for (int i = 0; i < torque.size(); ++i)
+    if (!(torque(i) > 0) || !std::isfinite(torque(i)))
+      throw std::invalid_argument("ManipulatorSimulation::setBrakeTorque: joint " + std::to_string(i + 1) +
+                                  ": the braking torque must be positive and finite");
+  brakeTorque_ = torque;
+}
+
 void ManipulatorSimulation::step(const JointVector& tau, double dt) {
   const int n = model_.getNumberOfJoints();
-  if (brakes_) {
-    qd_.setZero();
-    qdd_.setZero();
-    tauExt_.setZero();  // the brakes take every load
-    lastSubsteps_ = 1;
-    return;
-  }
   externalTorque();  // constant over the step
   // Sub-steps while a joint is at a stop: the stop's stiffness k against the joint's inertia
   // (at least its armature) gives the frequency to resolve.
@@ -101,7 +106,8 @@ void ManipulatorSimulation::integrate(const JointVector& tau, double h) {
   const double stopDamping = 2.0 * std::sqrt(stopStiffness_ * 0.1);
   for (int i = 0; i < n; ++i) {
     const LinkParameters& l = model_.getLink(i);
-    double t = std::clamp(tau(i), -model_.getTorqueLimit()(i), model_.getTorqueLimit()(i));
+    // With the brakes on the amplifiers are off: no motor torque.
+    double t = brakes_ ? 0.0 : std::clamp(tau(i), -model_.getTorqueLimit()(i), model_.getTorqueLimit()(i));
     t += tauExt_(i);
     t -= l.viscousFriction * l.gearRatio * l.gearRatio * qd_(i);
     if (q_(i) < l.positionMin) t += stopStiffness_ * (l.positionMin - q_(i)) - stopDamping * std::min(qd_(i), 0.0);
@@ -112,10 +118,12 @@ void ManipulatorSimulation::integrate(const JointVector& tau, double h) {
   qdd_ = data_.qdd;
   for (int i = 0; i < n; ++i) {
     double v = qd_(i) + h * qdd_(i);
-    // Coulomb friction: an impulse against the motion that stops the joint but never reverses it.
+    // Coulomb friction (and an engaged brake, which acts the same way with its braking torque):
+    // an impulse against the motion that stops the joint but never reverses it.
     const double m = data_.massMatrix(i, i);
-    const double friction = v > 0 ? coulombPos_(i) : (v < 0 ? -coulombNeg_(i) : 0.0);
-    const double dv = h * friction / m;
+    const double brake = brakes_ ? brakeTorque_(i) : 0.0;
+    const double friction = (v > 0 ? std::abs(coulombPos_(i)) : (v < 0 ? std::abs(coulombNeg_(i)) : 0.0)) + brake;
+    const double dv = h * friction / m;  // a magnitude
     if (std::abs(v) <= dv) {
       v = 0;
     } else {

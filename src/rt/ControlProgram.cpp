@@ -126,6 +126,7 @@ struct ControlProgram::Impl {
   std::atomic<double> time{0};
   std::atomic<std::uint64_t> cycles{0};
   std::atomic<std::uint64_t> overruns{0};
+  std::atomic<std::uint64_t> missed{0};  // deadlines skipped after overruns
   std::atomic<std::uint64_t> logSamples{0};
   std::atomic<bool> realTime{false};
   internal::DurationStats latency, computation;
@@ -266,7 +267,9 @@ struct ControlProgram::Impl {
       deadline += period;
       if (done > deadline) {  // overrun: skip the deadlines already missed
         overruns.fetch_add(1, std::memory_order_relaxed);
-        deadline += ((done - deadline) / period + 1) * period;
+        const std::int64_t skipped = (done - deadline) / period + 1;
+        missed.fetch_add(static_cast<std::uint64_t>(skipped), std::memory_order_relaxed);
+        deadline += skipped * period;
       }
       if (cycleLimit && k >= cycleLimit) break;
     }
@@ -314,6 +317,12 @@ struct ControlProgram::Impl {
       runReal();
     }
     self.exitControl();
+    // Missed cycles are reported when the loop ends (the cycle statistics and the log have them
+    // too), so that rows missing from a log never go unexplained.
+    if (const std::uint64_t m = missed.load())
+      std::fprintf(stderr, "rp: %s: %llu servo cycles missed in %llu overruns (of %llu cycles run)\n", name.c_str(),
+                   static_cast<unsigned long long>(m), static_cast<unsigned long long>(overruns.load()),
+                   static_cast<unsigned long long>(cycles.load()));
     {
       std::lock_guard<std::mutex> lock(endMutex);
       ended = true;
@@ -378,6 +387,7 @@ void ControlProgram::start() {
   d.stopRequested = false;
   d.cycles = 0;
   d.overruns = 0;
+  d.missed = 0;
   d.logSamples = 0;
   d.latency.reset();
   d.computation.reset();
@@ -464,11 +474,15 @@ void ControlProgram::waitUntilStopped() {
 bool ControlProgram::isRunning() const noexcept { return impl_->running.load(); }
 double ControlProgram::getTime() const noexcept { return impl_->time.load(std::memory_order_relaxed); }
 std::uint64_t ControlProgram::getCycleCount() const noexcept { return impl_->cycles.load(std::memory_order_relaxed); }
+std::uint64_t ControlProgram::getMissedCycleCount() const noexcept {
+  return impl_->missed.load(std::memory_order_relaxed);
+}
 
 ControlStatistics ControlProgram::getStatistics() const {
   ControlStatistics s;
   s.cycles = impl_->cycles.load();
   s.overruns = impl_->overruns.load();
+  s.missedCycles = impl_->missed.load();
   s.wakeupLatency = impl_->latency.summary();
   s.computationTime = impl_->computation.summary();
   s.logSamples = impl_->logSamples.load();

@@ -1,9 +1,13 @@
 # Runs PROGRAM with ARGS, reads its "final end-effector position: x y z" line and checks that
-# coordinate AXIS (0, 1, 2) lies in [MIN, MAX] and that the program exited 0.
+# coordinate AXIS (0, 1, 2) lies in [MIN, MAX], that the program exited 0 and that no system
+# shutdown happened.
 execute_process(COMMAND ${PROGRAM} ${ARGS} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 100)
 message("${out}${err}")
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "exit status ${rc}")
+endif()
+if("${out}${err}" MATCHES "rp: system shutdown")
+  message(FATAL_ERROR "the run ended in a system shutdown")
 endif()
 if(NOT out MATCHES "final end-effector position: ([-0-9.e]+) ([-0-9.e]+) ([-0-9.e]+)")
   message(FATAL_ERROR "no final position in the output")

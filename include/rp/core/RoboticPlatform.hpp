@@ -119,9 +119,17 @@ class RoboticPlatform {
   /// @param[in] starter  function starting the viewer
   static void setGuiStarter(std::function<void()> starter);
 
-  /// Stops every control program, completes the log file and destroys the objects the
-  /// ObjectManager created. Called automatically at exit after init().
+  /// Ends the platform: waits for a system shutdown in progress to complete (or, if none was
+  /// requested, holds every arm still running until it is at rest and switches its power off),
+  /// destroys the objects the ObjectManager created, stops every control program and completes
+  /// the log file. Called automatically at exit after init(), which then sets the exit status:
+  /// 128 + the signal number after SIGINT or SIGTERM, kExitAfterShutdown after any other
+  /// system shutdown, else the program's own.
   static void finish();
+
+  /// Exit status of a program that init() started and that ends after a system shutdown other
+  /// than by a signal (a limit violation, a fault, an emergency stop).
+  static constexpr int kExitAfterShutdown = 3;
 };
 
 }  // namespace rp

@@ -28,14 +28,21 @@ class SimulatedClock;
 ///    none);
 /// 3. run the servo control (a DefaultPositionControl unless switched), plus the gravity torque
 ///    when gravity compensation is on (only the gravity torque in zero-gravity mode);
-/// 4. check the limits: a joint outside its position limits, faster than its velocity limit, or a
-///    commanded torque above its torque limit sets the error status (naming the joint, the value
-///    and the limit) and requests a system shutdown;
+/// 4. saturate the command (servo control plus gravity) at each joint's torque limit (counted, and
+///    logged in the column `saturated`), then check the limits: a joint outside its position
+///    limits or faster than its velocity limit sets the error status (naming the joint, the value
+///    and the limit) and requests a system shutdown. So does a torque or setpoint that is not a
+///    number, or an exception thrown by the servo control or the trajectory generator (its
+///    message in the error status); a joint reading that is not a number switches the power off
+///    at once;
 /// 5. output the torques (to the amplifiers, or integrate the model's forward dynamics);
-/// 6. publish the state for other threads and sample the log variables `q`, `qd`, `qdes`, `tau`.
+/// 6. publish the state for other threads and sample the log variables `q`, `qd`, `qdes`,
+///    `qddes`, `qdddes`, `tau`, `saturated` and `missed` (deadlines skipped so far).
 ///
-/// Shutdown (system shutdown or after a violation): a damped hold (velocity damping plus gravity
-/// compensation) until the arm is at rest, then power off (brakes on).
+/// Shutdown (system shutdown, a fault, or the object's destruction while the arm is powered): a
+/// damped hold (velocity damping plus gravity compensation, within the torque limits) until the
+/// arm has been at rest for 50 ms (at most 3 s), then power off (brakes on). However the servo
+/// loop ends, its last act switches the amplifiers off and writes 0 V to every joint.
 ///
 /// The arm power is on when the loop starts, holding the position the arm is in. In simulation
 /// mode the arm starts at rest at the model's home position.
@@ -104,9 +111,16 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void releaseServoControl(ServoControl& control) override;
   void releaseTrajectoryGenerator(TrajectoryGenerator& generator) override;
 
-  /// Starts the damped hold and then switches the power off.
+  /// Starts the damped hold (velocity damping plus gravity compensation, within the torque
+  /// limits) until the arm is at rest, then switches the power off and engages the brakes. The
+  /// servo loop goes on running (holding the outputs off) until the system shutdown stops it.
   void startShutdown() override;
   bool isShutdownComplete() const override;
+
+  /// Number of powered cycles in which the command (servo control plus gravity) was saturated at
+  /// a joint's torque limit. The log column `saturated` has the number of saturated joints of
+  /// each cycle. Real-time safe: yes.
+  std::uint64_t getSaturatedCycleCount() const noexcept { return saturatedCycles_.load(std::memory_order_relaxed); }
 
   Model3D get3DModel() const override;
   ControlPanel getControlPanel() const override;
@@ -143,9 +157,17 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void waitUntilNotExecuting(const void* object) const;
   void checkLimits();
   void violation(const char* what, int joint, double value, double limit, const char* unit);
+  // Records a fault (printf-style message after the object's name), starts the damped hold and
+  // requests the system shutdown; the first fault wins. Real-time safe.
+  void fault(const char* format, ...) noexcept __attribute__((format(printf, 2, 3)));
+  void holdTorque();
+  void powerOffNow() noexcept;
+  void finishCycle(double t, double dt);
+  void holdUntilSafe();
   void publish();
   bool readHardware();
   void writeHardware();
+  void writeOutputsOff() noexcept;
   void ioFailure(const char* what, int line);
 
   std::unique_ptr<ManipulatorModel> model_;
@@ -175,6 +197,10 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   Setpoint setpoint_;
   bool power_ = false;
   double restTime_ = 0, shutdownStart_ = 0;
+  double lastCycleTime_ = -1;   // time of the previous cycle (-1 before the first)
+  double saturatedJoints_ = 0;  // log column `saturated`: joints at their torque limit this cycle
+  double missedCycles_ = 0;     // log column `missed`: deadlines skipped so far
+  std::atomic<std::uint64_t> saturatedCycles_{0};
   char nameBuffer_[64] = {};
   char errorBuffer_[256] = {};
 

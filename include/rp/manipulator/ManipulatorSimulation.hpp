@@ -16,7 +16,7 @@ namespace rp {
 /// never reverses the motion, so a joint sticks when the torque is below its Coulomb friction;
 /// torques are saturated at the model's torque limits; joints meet their limits as stiff
 /// spring-damper stops, with sub-steps while a stop is engaged; and brakes hold every joint while
-/// the brakes are on. An external wrench at the end-effector adds \f$J^T F\f$; a wrench at a
+/// the brakes are on (with a finite braking torque). An external wrench at the end-effector adds \f$J^T F\f$; a wrench at a
 /// point on link \f$k\f$ adds \f$J_k(p)^T F\f$, with \f$J_k(p)\f$ the geometric Jacobian of that
 /// point (columns of joints beyond \f$k\f$ zero).
 ///
@@ -42,11 +42,19 @@ class ManipulatorSimulation {
   /// Puts the arm at rest in `q` [rad]. Real-time safe: yes.
   void setState(const JointVector& q, const JointVector& qd);
 
-  /// Engages (true) or releases (false) the brakes; engaged brakes stop and hold every joint.
-  /// Real-time safe: yes.
+  /// Engages (true) or releases (false) the brakes. Engaged brakes act as real ones do: the
+  /// motors are off (the applied torques are ignored) and each joint's brake opposes its motion
+  /// with at most its braking torque (see setBrakeTorque()), so a moving arm stops over a finite
+  /// time and distance and an arm at rest is held while the load on each joint (gravity, external
+  /// wrenches) stays below its braking torque. Real-time safe: yes.
   void setBrakes(bool on) { brakes_ = on; }
   /// Whether the brakes are engaged.
   bool getBrakes() const { return brakes_; }
+  /// Sets each joint's braking torque [N m] (n x 1, each > 0). Default: the joint's torque limit.
+  /// @throws std::invalid_argument on a wrong size or a value that is not positive and finite
+  void setBrakeTorque(const JointVector& torque);
+  /// Each joint's braking torque [N m].
+  const JointVector& getBrakeTorque() const { return brakeTorque_; }
 
   /// Sets the wrench the environment applies to the end-effector, in world coordinates: force
   /// [N] then moment [N m] about the end-effector's origin; zero for none. Real-time safe: yes.
@@ -82,7 +90,7 @@ class ManipulatorSimulation {
 
   const ManipulatorModel& model_;
   ManipulatorData data_;
-  JointVector q_, qd_, qdd_, tauTotal_, tauExt_, coulombPos_, coulombNeg_;
+  JointVector q_, qd_, qdd_, tauTotal_, tauExt_, coulombPos_, coulombNeg_, brakeTorque_;
   Vector<6> wrench_;
   std::array<Vector<3>, kMaxJoints> linkPoint_{};
   std::array<Vector<6>, kMaxJoints> linkWrench_{};

@@ -30,7 +30,8 @@ struct LatencyStatistics {
 /// Statistics of a control program since start().
 struct ControlStatistics {
   std::uint64_t cycles = 0;      ///< cycles run
-  std::uint64_t overruns = 0;    ///< deadlines missed (a cycle ended after the next deadline)
+  std::uint64_t overruns = 0;    ///< cycles that ended after the next deadline
+  std::uint64_t missedCycles = 0;  ///< deadlines skipped because of overruns (cycles that never ran)
   LatencyStatistics wakeupLatency;    ///< how late the thread woke after each deadline (real clock)
   LatencyStatistics computationTime;  ///< time spent in control() and the bookkeeping around it
   std::uint64_t logSamples = 0;       ///< log samples taken
@@ -134,6 +135,9 @@ class ControlProgram {
   double getTime() const noexcept;
   /// Number of cycles completed. Real-time safe: yes.
   std::uint64_t getCycleCount() const noexcept;
+  /// Number of deadlines skipped since start() because a cycle overran (on the real clock: the
+  /// cycles that never ran; the next cycle's time jumps over them). Real-time safe: yes.
+  std::uint64_t getMissedCycleCount() const noexcept;
   /// Statistics since start(). Real-time safe: no.
   ControlStatistics getStatistics() const;
   /// @}
