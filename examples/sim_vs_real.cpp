@@ -12,7 +12,8 @@
 //   server: `[puma]`, `class Puma560`, `simulationMode off`, `hwserver cell` with
 //   `rp-hwserver -name cell -board puma560` running (a Puma 560 wired to an I/O board);
 // - after queueing the two motions the program follows them to the end and prints the largest
-//   joint-position difference between the arms (the paper's program only queued them).
+//   joint-position difference between the arms, the second interpolated at the first's sample
+//   times (the paper's program only queued them).
 #include "RoboticPlatform.hpp"
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include <cmath>
 #include <iostream>
 #include <thread>
+#include <vector>
 
 int main(int argc, char* argv[]) {
   // Initialize the Robotic Platform framework
@@ -46,19 +48,46 @@ int main(int argc, char* argv[]) {
   target = -50, 0, -70, 50, -80, 0;
   tragen.move(target);
 
-  // Follow the motion and compare the two arms in the same servo cycles (same clock time).
-  double largest = 0;
-  StateSnapshot a, b;
+  // Follow the motion, recording each arm's published joint positions with their servo-cycle
+  // times; then compare the arms at the same instants: the second arm's positions interpolated
+  // (linearly) at the first arm's sample times (the two servo loops run on their own clocks'
+  // cycles, so their samples rarely share a time stamp).
+  struct Sample {
+    double time;
+    double q[6];
+  };
+  std::vector<Sample> real, simulated;
+  auto record = [](const Puma560& arm, std::vector<Sample>& samples) {
+    StateSnapshot s;
+    if (!arm.getStateSnapshot(s) || (!samples.empty() && s.time <= samples.back().time)) return;
+    Sample sample{s.time, {}};
+    std::copy(s.values, s.values + 6, sample.q);
+    samples.push_back(sample);
+  };
   while (!tragen.isDone() && !ObjectManager::isShutdownRequested()) {
-    if (puma.getStateSnapshot(a) && pumaSimulated.getStateSnapshot(b) && a.time == b.time) {
-      for (int i = 0; i < 6; ++i) largest = std::max(largest, std::abs(a.values[i] - b.values[i]));
-    }
-    std::this_thread::sleep_for(std::chrono::microseconds(100));
+    record(puma, real);
+    record(pumaSimulated, simulated);
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  double largest = 0;
+  std::size_t k = 0, compared = 0;
+  for (const Sample& s : real) {
+    while (k + 1 < simulated.size() && simulated[k + 1].time < s.time) ++k;
+    if (k + 1 >= simulated.size() || simulated[k].time > s.time) continue;  // outside the other record
+    const Sample& s0 = simulated[k];
+    const Sample& s1 = simulated[k + 1];
+    // Only between samples one servo cycle apart (or at a sample), where the linear interpolation
+    // is accurate; on the simulated clock both arms' samples share their times.
+    if (s.time != s0.time && s.time != s1.time && s1.time - s0.time > 1.5 * puma.getPeriod()) continue;
+    const double w = (s.time - s0.time) / (s1.time - s0.time);
+    for (int i = 0; i < 6; ++i) largest = std::max(largest, std::abs(s.q[i] - ((1 - w) * s0.q[i] + w * s1.q[i])));
+    ++compared;
   }
   if (ObjectManager::isShutdownRequested()) {  // a fault, an emergency stop or Ctrl-C ended the motion
     std::cerr << "sim_vs_real: stopped by a system shutdown: " << ObjectManager::getShutdownReason() << std::endl;
     return RoboticPlatform::kExitAfterShutdown;
   }
-  std::cout << "sim_vs_real: largest joint-position difference between the arms: " << largest << " rad" << std::endl;
+  std::cout << "sim_vs_real: " << compared << " instants compared; largest joint-position difference between the arms: "
+            << largest << " rad" << std::endl;
   return puma.getErrorCode() == 0 && pumaSimulated.getErrorCode() == 0 ? 0 : 1;
 }
