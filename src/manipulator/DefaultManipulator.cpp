@@ -424,6 +424,13 @@ void DefaultManipulator::control() {
   if (board_) {
     if (!readHardware()) ioFailure("reading the encoders", 0);
   } else {
+    // On the real clock a cycle delayed by a busy machine skips deadlines; the arm moved on under
+    // the last torque (still in tau_) meanwhile, as a real one does: integrate that time, in
+    // steps of one period, before reading the joints.
+    if (simulatedClock_ == nullptr && lastCycleTime_ >= 0 && t - lastCycleTime_ > 1.5 * dt) {
+      const int skipped = std::min(kMaxCatchUpSteps, static_cast<int>(std::lround((t - lastCycleTime_) / dt)) - 1);
+      for (int k = 0; k < skipped; ++k) sim_->step(tau_, dt);
+    }
     if (wrench_->read(n + 1)) {
       Vector<3> point;
       Vector<6> wrench;
@@ -543,17 +550,12 @@ void DefaultManipulator::control() {
 }
 
 void DefaultManipulator::finishCycle(double t, double dt) {
-  // 5. Output: no torque without power; the simulation integrates the dynamics over the time
-  // that really passed since the last cycle (on the real clock a stall skips deadlines, and a
-  // real arm moves on under the last torque meanwhile), in steps of one period.
+  // 5. Output: no torque without power; the simulation integrates the dynamics over one period.
   if (!power_) tau_.setZero();
   if (board_) {
     writeHardware();
   } else {
-    int steps = 1;
-    if (simulatedClock_ == nullptr && lastCycleTime_ >= 0 && t - lastCycleTime_ > 1.5 * dt)
-      steps = std::min(kMaxCatchUpSteps, static_cast<int>(std::lround((t - lastCycleTime_) / dt)));
-    for (int k = 0; k < steps; ++k) sim_->step(tau_, dt);
+    sim_->step(tau_, dt);
   }
   lastCycleTime_ = t;
 

@@ -4,9 +4,13 @@
 // mode, and an allocation-free servo cycle. (Step and trajectory tracking: Tracking_test.cpp.)
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <atomic>
 #include <cmath>
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <random>
 #include <thread>
@@ -346,6 +350,22 @@ TEST_F(ManipulatorTest, PowerOffEngagesTheBrakes) {
   puma.enableArmPower();
   ASSERT_TRUE(puma.waitForCycles(50));
   EXPECT_TRUE(puma.isArmPowerOn());
+}
+
+TEST_F(ManipulatorTest, ARateFromTheQMotorConfigIsThePeriodTheServoControlIntegratesOver) {
+  // The qmotorConfig file is applied at the end of the constructor, after the default control
+  // took the period: the control must integrate over the new one (2 ms), not the default 1 ms.
+  const auto dir = std::filesystem::temp_directory_path() / ("rp-rate-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "leader.cfg") << "rate 500\n";
+  std::ofstream(dir / "rp.cfg") << "[leader]\nclass Puma560\nqmotorConfig leader.cfg\n";
+  RoboticPlatform::setConfiguration(Configuration::read((dir / "rp.cfg").string()));
+  std::filesystem::remove_all(dir);
+  Puma560 puma("leader");
+  ASSERT_TRUE(puma.waitForCycles(10));
+  EXPECT_EQ(puma.getPeriod(), 0.002);
+  EXPECT_EQ(puma.getDefaultPositionControl().getPeriod(), 0.002);
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
 }
 
 TEST_F(ManipulatorTest, CreatedByNameFromTheConfiguration) {

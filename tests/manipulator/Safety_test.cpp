@@ -8,10 +8,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
+#include <thread>
 
 #include "SimulatedArmTest.hpp"
 #include "rp/RoboticPlatform.hpp"
@@ -198,6 +200,64 @@ TEST_F(SafetyTest, AfterAFaultTheDampedHoldStopsTheArmThenTheBrakesEngage) {
   EXPECT_LE(peakTorque, 1.0) << "the hold stays within the torque limits";
   simClock().resume();
   ObjectManager::setShutdownTimeout(5);
+}
+
+// Pushes joint 1 with a constant torque and stalls the servo thread once for 60 ms, as a busy
+// machine may; records each cycle's time and joint-1 velocity.
+class StallingPush : public ServoControl {
+ public:
+  static constexpr int kCycles = 300;
+  ~StallingPush() override { releaseFromManipulator(); }
+  void calculate() override {
+    auto& m = dynamic_cast<DefaultManipulator&>(*d_manipulator);
+    const int k = count.load();
+    if (k < kCycles) {
+      time[k] = m.getTime();
+      velocity[k] = m.getJointVelocity()(0);
+      count.store(k + 1);
+    }
+    if (k == 100) std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    JointVector t = JointVector::Zero(6);
+    t(0) = 35;
+    m.setControlOutput(t);
+  }
+  double time[kCycles] = {}, velocity[kCycles] = {};
+  std::atomic<int> count{0};
+};
+
+TEST(BusyMachine, OnTheRealClockTheSimulatedArmMovesOnThroughAStall) {
+  // The stalled cycle skips deadlines; the next cycle's reading must show the arm accelerated for
+  // the whole time that passed, as a real arm under the last torque would (before, the simulation
+  // advanced one period per cycle whatever the time, so the arm fell behind its setpoints and the
+  // controller's catch-up could trip a velocity limit).
+  RoboticPlatform::setConfiguration(Configuration());
+  RoboticPlatform::setSimulationModeOn();
+  RoboticPlatform::useRealClock();
+  ObjectManager::resetShutdown();
+  {
+    Puma560 puma;
+    StallingPush push;
+    puma.setServoControl(push);
+    for (int i = 0; i < 400 && push.count.load() < StallingPush::kCycles; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    ASSERT_EQ(push.count.load(), StallingPush::kCycles);
+    puma.disableArmPower();
+    // The stall: the largest gap between two cycles' times.
+    int k = 1;
+    for (int i = 1; i < StallingPush::kCycles; ++i)
+      if (push.time[i] - push.time[i - 1] > push.time[k] - push.time[k - 1]) k = i;
+    const double gap = push.time[k] - push.time[k - 1];
+    ASSERT_GT(gap, 0.05);
+    // Acceleration over the 20 cycles before the stall, and over the stall itself.
+    const double before = (push.velocity[k - 1] - push.velocity[k - 21]) / (push.time[k - 1] - push.time[k - 21]);
+    const double across = (push.velocity[k] - push.velocity[k - 1]) / gap;
+    EXPECT_GT(before, 1.0);
+    EXPECT_NEAR(across / before, 1.0, 0.25) << "before " << before << " rad/s^2, across the stall " << across;
+    EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
+    EXPECT_GT(puma.getStatistics().missedCycles, 40u);
+  }
+  RoboticPlatform::useSimulatedClock();
+  ObjectManager::resetShutdown();
 }
 
 TEST(SimulatedBrakes, StopAMovingJointWithAFiniteTorqueAndHoldAtRest) {

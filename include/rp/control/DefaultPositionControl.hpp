@@ -51,6 +51,10 @@ class DefaultPositionControl : public ServoControl {
   JointVector& getKd() { return kd_; }
   /// Integral gains (tunable parameter `ki`).
   JointVector& getKi() { return ki_; }
+  /// The servo period the integral term integrates over [s]: the manipulator's, taken when the
+  /// control is attached and again each time it is activated (so a rate set after attach(), e.g.
+  /// by a qmotorConfig file, is the one used).
+  double getPeriod() const { return period_; }
 
   /// Natural frequency of the default gains [rad/s].
   static constexpr double kDefaultBandwidth = 25.0;
