@@ -458,9 +458,12 @@ void DefaultManipulator::control() {
     return finishCycle(t, dt);
   }
 
-  // 2. The setpoint: the trajectory generator's, or hold.
+  // 2. The setpoint: the trajectory generator's, or hold. Every hand-over (another servo control
+  // set or one released, zero-gravity mode ending, a generator released, the power coming on)
+  // holds the arm where it is in this cycle: bumpless, never back to a stale pose.
   const bool zeroG = zeroGravity_.load(std::memory_order_relaxed);
-  if (!power_ || zeroG || holdHere_.exchange(false, std::memory_order_acq_rel)) hold_ = q_;
+  const bool controlChanges = servoControl_.load(std::memory_order_acquire) != activeControl_;
+  if (!power_ || zeroG || controlChanges || holdHere_.exchange(false, std::memory_order_acq_rel)) hold_ = q_;
   setpoint_.position = hold_;
   setpoint_.velocity.setZero();
   setpoint_.acceleration.setZero();

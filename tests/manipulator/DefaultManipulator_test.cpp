@@ -352,6 +352,43 @@ TEST_F(ManipulatorTest, PowerOffEngagesTheBrakes) {
   EXPECT_TRUE(puma.isArmPowerOn());
 }
 
+TEST_F(ManipulatorTest, ReleasingAServoControlHoldsTheArmWhereItIsNotWhereItWas) {
+  // A servo control that does nothing (gravity compensation only) while a 40 N push moves the arm
+  // for 1 s, then the control is destroyed: the default control takes over holding the arm where
+  // it is at that cycle. Before, it pulled the arm back to the pose of before the push and tripped
+  // the torque limit ("joint 2 torque 237.202 N m exceeds the limit") every time.
+  struct DoNothing : ServoControl {
+    ~DoNothing() override { releaseFromManipulator(); }
+    void calculate() override {}
+  };
+  Puma560 puma;
+  simClock().pause();
+  const Transform start = puma.getEndEffectorTransform();
+  Vector<6> push;
+  push(0) = 40;
+  JointVector atRelease;
+  {
+    DoNothing nothing;
+    puma.setServoControl(nothing);
+    puma.applyExternalWrench(push);
+    ASSERT_TRUE(puma.runCycles(1000));
+    puma.clearExternalWrench();
+    atRelease = puma.getJointPosition();
+  }
+  ASSERT_TRUE(puma.runCycles(500));
+  simClock().resume();
+  EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+  const JointVector q = puma.getJointPosition();
+  const ManipulatorModel& model = puma.getModel();
+  ManipulatorData data(model);
+  const Eigen::Vector3d released = forwardKinematics(model, data, atRelease).topRightCorner<3, 1>();
+  const Eigen::Vector3d now = forwardKinematics(model, data, q).topRightCorner<3, 1>();
+  const Eigen::Vector3d before = start.topRightCorner<3, 1>();
+  ASSERT_GT((released - before).norm(), 0.05) << "the push moved the arm";
+  EXPECT_LT((now - released).norm(), 0.25 * (released - before).norm()) << "held near where it was released";
+}
+
 TEST_F(ManipulatorTest, ARateFromTheQMotorConfigIsThePeriodTheServoControlIntegratesOver) {
   // The qmotorConfig file is applied at the end of the constructor, after the default control
   // took the period: the control must integrate over the new one (2 ms), not the default 1 ms.
