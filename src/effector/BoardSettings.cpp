@@ -77,7 +77,9 @@ TwoLineBoard createTwoLineBoard(const ConfigSection& section, const char* lineA,
       throw ConfigError(section.fileName(), section.line(),
                         "[" + section.name() + "] has 'board hwserver' but no 'server' setting");
     try {
-      out.board = std::make_unique<HwServerIoBoard>(section.getWord("server"));
+      // A background heartbeat: the lines stay while this process runs, and go off when it ends.
+      out.board = std::make_unique<HwServerIoBoard>(section.getWord("server"), 500,
+                                                    HwServerIoBoard::Heartbeat::kBackgroundThread);
     } catch (const IoException& e) {
       out.deviceError = e.what();  // the server is not running: a device error, reported by the object
       return out;

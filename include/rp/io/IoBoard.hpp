@@ -82,6 +82,17 @@ class IoBoard {
   /// Real-time safe: depends on the implementation.
   virtual IoStatus readEncoder(int encoder, std::int64_t& counts) noexcept = 0;
 
+  /// Waits until the outputs written so far reached the device and returns its answer. Boards
+  /// that write synchronously (every board but `HwServerIoBoard`) have nothing to wait for: each
+  /// write already returned the device's answer.
+  /// @param[in] timeoutMs  the longest wait [ms]
+  /// @return `kOk`, or the failure of one of the writes, or `kTimeout`
+  /// Real-time safe: depends on the implementation (`HwServerIoBoard`: no, it sleeps).
+  virtual IoStatus confirmWrites(int timeoutMs) noexcept {
+    (void)timeoutMs;
+    return IoStatus::kOk;
+  }
+
   /// Status of the last failed operation (`kOk` if none failed yet).
   /// Real-time safe: yes.
   IoStatus lastStatus() const noexcept { return error_.status(); }
