@@ -277,9 +277,7 @@ IoStatus HwServerIoBoard::readAnalogInput(int channel, double& volts) noexcept {
 
 IoStatus HwServerIoBoard::writeAnalogOutput(int channel, double volts) noexcept {
   if (IoStatus s = checked(channel, numAnalogOutputs(), "analog output"); s != IoStatus::kOk) return s;
-  if (std::isnan(volts))
-    return error_.set(IoStatus::kInvalidValue, "hardware server '%s': analog output %d: NaN volts refused",
-                      name_.c_str(), channel);
+  if (IoStatus s = checkVolts(channel, volts); s != IoStatus::kOk) return s;  // the server's board clamps
   shm_->analogOutOwner[channel].store(static_cast<std::int8_t>(slot_ + 1));
   shm_->analogOut[channel].store(volts);
   analogRequest_[channel] = shm_->analogOutRequest[channel].fetch_add(1, std::memory_order_acq_rel) + 1;

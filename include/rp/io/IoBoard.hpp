@@ -71,7 +71,8 @@ class IoBoard {
   /// Sets an analog output channel.
   /// @param[in] channel  0 .. numAnalogOutputs()-1
   /// @param[in] volts  the output voltage [V]; the implementation clamps it to its range
-  /// @return `kOk`, `kInvalidLine`, or a communication error
+  /// @return `kOk`, `kInvalidLine`, `kInvalidValue` (NaN: refused, the output keeps its value),
+  ///         or a communication error
   /// Real-time safe: depends on the implementation.
   virtual IoStatus writeAnalogOutput(int channel, double volts) noexcept = 0;
 
@@ -115,6 +116,17 @@ class IoBoard {
   IoStatus checkIndex(int index, int count, const char* what) noexcept {
     if (index >= 0 && index < count) return IoStatus::kOk;
     return error_.set(IoStatus::kInvalidLine, "%s %d out of range (board has %d)", what, index, count);
+  }
+
+  /// Checks a voltage for an analog output: NaN is refused (`kInvalidValue`, nothing is written);
+  /// every other value, infinities too, is then clamped to the board's range by the caller.
+  /// @param[in] channel  the analog output, for the message
+  /// @param[in] volts  the voltage to check
+  /// @return `kOk` or `kInvalidValue`
+  /// Real-time safe: yes.
+  IoStatus checkVolts(int channel, double volts) noexcept {
+    if (volts == volts) return IoStatus::kOk;  // false only for NaN
+    return error_.set(IoStatus::kInvalidValue, "analog output %d: NaN volts refused (nothing written)", channel);
   }
 };
 
