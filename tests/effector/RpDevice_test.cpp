@@ -7,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "BarrettHandEmulator.hpp"
 #include "ChildProcess.hpp"
 #include "ModbusEmulator.hpp"
 #include "NetFtEmulator.hpp"
@@ -150,6 +151,25 @@ TEST_F(RpDevice, ReadsAForceTorqueSensorAsJson) {
   const auto [status, out] = run({"-config", cfg, "ft", "read"});
   EXPECT_EQ(status, 0);
   EXPECT_EQ(out, "{\"force\": [1.5, 0, -2], \"torque\": [0, 0.125, 0]}");
+}
+
+TEST_F(RpDevice, ReadsAHandWithoutInitialisingIt) {
+  emulator::BarrettHandEmulator hand;
+  hand.start();
+  const auto cfg = writeConfig("[hand]\nclass BarrettHand\nport " + hand.devicePath() + "\ntimeout 2000\n");
+  const auto [status, out] = run({"-config", cfg, "hand", "read"});
+  EXPECT_EQ(status, 0);
+  EXPECT_EQ(out, "{\"state\": \"unknown\", \"positions\": [0, 0, 0, 0]}");
+  EXPECT_EQ(hand.commands(), std::vector<std::string>{"FGET P"}) << "no HI (a calibration move of every finger)";
+  EXPECT_EQ(run({"-config", cfg, "hand", "Initialize"}).first, 0);
+  EXPECT_EQ(hand.commands().back(), "HI");
+}
+
+TEST_F(RpDevice, HandWithoutPortIsAConfigurationError) {
+  const auto cfg = writeConfig("[hand]\nclass BarrettHand\n");
+  const auto [status, out] = runMerged({"-config", cfg, "hand", "read"});
+  EXPECT_EQ(status, 2) << out;
+  EXPECT_EQ(out, "rp-device: " + cfg + ":1: [hand] has no 'port' setting (the hand's serial port, e.g. /dev/ttyS0)");
 }
 
 TEST_F(RpDevice, DeviceErrorsExitWith1) {
