@@ -28,8 +28,14 @@ std::string commandList(const rp::RoboticObject& object) {
   return out.empty() ? "none" : out;
 }
 
+// The object's message, naming the object once (objects start their messages with their name).
+std::string namedMessage(const rp::RoboticObject& object, const std::string& message) {
+  const std::string prefix = object.getName() + ":";
+  return message.compare(0, prefix.size(), prefix) == 0 ? message : object.getName() + ": " + message;
+}
+
 int deviceError(const rp::RoboticObject& object) {
-  std::cerr << "rp-device: " << object.getName() << ": " << object.getErrorStatus().message << std::endl;
+  std::cerr << "rp-device: " << namedMessage(object, object.getErrorStatus().message) << std::endl;
   return 1;
 }
 

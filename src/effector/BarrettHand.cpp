@@ -10,7 +10,10 @@ namespace rp {
 
 BarrettHand::BarrettHand(const std::string& name) : Gripper(name) {
   if (const ConfigSection* section = configSection()) {
-    if (section->has("port")) config_.port = section->getWord("port");
+    if (!section->has("port"))
+      throw ConfigError(section->fileName(), section->line(),
+                        "[" + section->name() + "] has no 'port' setting (the hand's serial port, e.g. /dev/ttyS0)");
+    config_.port = section->getWord("port");
     auto integer = [&](const char* setting, int& target, int lo, int hi) {
       if (const ConfigSetting* s = section->find(setting)) {
         const double v = section->getNumbers(setting).at(0);
@@ -54,13 +57,19 @@ bool BarrettHand::check(IoStatus status) {
   return false;
 }
 
-bool BarrettHand::ready() {
+// The port is open (opened now if needed); the hand is not initialised by this.
+bool BarrettHand::opened() {
   if (config_.port.empty()) {
     setError(1, (getName() + ": no serial port configured (rp.cfg setting 'port')").c_str());
     return false;
   }
+  return driver_->isOpen() || check(driver_->open());
+}
+
+// Ready for a motion command: open and initialised (HI once).
+bool BarrettHand::ready() {
   if (initialized_ && driver_->isOpen()) return true;
-  if (!driver_->isOpen() && !check(driver_->open())) return false;
+  if (!opened()) return false;
   if (!check(driver_->initialize())) return false;
   initialized_ = true;
   return true;
@@ -80,7 +89,7 @@ bool BarrettHand::hardwareRelax() { return ready() && check(driver_->relax()); }
 
 bool BarrettHand::readPositions(std::array<int, 4>& counts) {
   if (isSimulationModeOn()) return false;
-  return ready() && check(driver_->readPositions(counts));
+  return opened() && check(driver_->readPositions(counts));  // a reading never moves the fingers (no HI)
 }
 
 bool BarrettHand::handleMessage(const std::string& type, const std::string& payload, std::string& reply) {

@@ -77,7 +77,9 @@ TwoLineBoard createTwoLineBoard(const ConfigSection& section, const char* lineA,
       throw ConfigError(section.fileName(), section.line(),
                         "[" + section.name() + "] has 'board hwserver' but no 'server' setting");
     try {
-      out.board = std::make_unique<HwServerIoBoard>(section.getWord("server"));
+      // A background heartbeat: the lines stay while this process runs, and go off when it ends.
+      out.board = std::make_unique<HwServerIoBoard>(section.getWord("server"), 500,
+                                                    HwServerIoBoard::Heartbeat::kBackgroundThread);
     } catch (const IoException& e) {
       out.deviceError = e.what();  // the server is not running: a device error, reported by the object
       return out;
@@ -94,8 +96,10 @@ bool driveTwoLines(IoBoard& board, int lineA, bool valueA, int lineB, bool value
   const bool offFirstA = !valueA;
   const int first = offFirstA ? lineA : lineB, second = offFirstA ? lineB : lineA;
   const bool firstValue = offFirstA ? valueA : valueB, secondValue = offFirstA ? valueB : valueA;
+  // Done only when the device has both (through a hardware server: after the server wrote them
+  // and the board accepted them; other boards answer each write at once).
   if (board.writeDigitalOutput(first, firstValue) != IoStatus::kOk ||
-      board.writeDigitalOutput(second, secondValue) != IoStatus::kOk) {
+      board.writeDigitalOutput(second, secondValue) != IoStatus::kOk || board.confirmWrites(kConfirmTimeoutMs) != IoStatus::kOk) {
     error = board.lastError();
     return false;
   }

@@ -21,7 +21,11 @@ struct TwoLineBoard {
 // Throws ConfigError (FILE:LINE) for invalid or missing settings.
 TwoLineBoard createTwoLineBoard(const ConfigSection& section, const char* lineA, const char* lineB);
 
-// Sets two outputs; on failure stores "NAME: what failed: board message" in `error`.
+// How long a command waits for the device to confirm its outputs (a hardware server's cycle) [ms].
+constexpr int kConfirmTimeoutMs = 2000;
+
+// Sets two outputs and waits until the device confirmed them (IoBoard::confirmWrites); on failure
+// stores the board's message in `error`.
 bool driveTwoLines(IoBoard& board, int lineA, bool valueA, int lineB, bool valueB, std::string& error);
 
 }  // namespace rp::internal

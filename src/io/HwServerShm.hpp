@@ -11,10 +11,24 @@
 namespace rp::internal {
 
 constexpr std::uint64_t kHwServerMagic = 0x52504857'53525631ULL;  // "RPHWSRV1"
-constexpr std::uint32_t kHwServerVersion = 1;
-constexpr int kHwServerMaxLines = 64;  // per kind of line
+constexpr std::uint32_t kHwServerVersion = 2;
+constexpr int kHwServerMaxLines = 64;    // per kind of line
+constexpr int kHwServerMaxClients = 16;  // attached HwServerIoBoard objects at a time
 
 enum class HwServerState : std::int32_t { kStarting = 0, kRunning = 1, kStopped = 2 };
+
+// Life of a client slot. A client claims a free slot (kFree -> kClaiming, fills pid and
+// heartbeat, -> kAttached). Its destructor sets kClosed; the server's watchdog sets kExpired when
+// the client fell silent while one of its outputs was on. The server switches off every output a
+// closed or expired slot owns, then frees a closed slot at once and an expired one when its
+// process is gone (until then the silent client's writes are refused).
+enum class HwClientState : std::int32_t { kFree = 0, kClaiming = 1, kAttached = 2, kClosed = 3, kExpired = 4 };
+
+struct HwClientSlot {
+  std::atomic<std::int32_t> state;        // an HwClientState
+  std::atomic<std::int32_t> pid;          // the client's process
+  std::atomic<std::int64_t> heartbeatNs;  // CLOCK_MONOTONIC of the client's last operation (or keep-alive)
+};
 
 struct HwServerShm {
   std::uint64_t magic;
@@ -36,6 +50,29 @@ struct HwServerShm {
   std::atomic<double> analogIn[kHwServerMaxLines];
   std::atomic<double> analogOut[kHwServerMaxLines];
   std::atomic<std::int64_t> encoders[kHwServerMaxLines];
+  // Client watchdog: every output line is owned by the client that wrote it last (slot + 1, 0 =
+  // nobody); a silent, closed or dead owner's lines are switched off by the server.
+  std::atomic<std::int64_t> watchdogNs;   // a client silent for longer than this is cut off
+  std::atomic<std::uint64_t> watchdogTrips;  // clients cut off so far
+  std::atomic<std::int32_t> lastTripPid;     // the last one's process and silence
+  std::atomic<std::int64_t> lastTripSilenceNs;
+  HwClientSlot clients[kHwServerMaxClients];
+  std::atomic<std::int8_t> digitalOutOwner[kHwServerMaxLines];
+  std::atomic<std::int8_t> analogOutOwner[kHwServerMaxLines];
+  // What the server last wrote to the board and the board accepted (the real output state).
+  std::atomic<std::uint8_t> digitalOutApplied[kHwServerMaxLines];
+  std::atomic<double> analogOutApplied[kHwServerMaxLines];
+  // Acknowledgement of writes: a client counts up a line's request number after storing the value;
+  // the server, after handling that request, stores its number in ...Done and the board's answer
+  // (an rp::IoStatus) in ...Result.
+  std::atomic<std::uint32_t> digitalOutRequest[kHwServerMaxLines];
+  std::atomic<std::uint32_t> digitalOutDone[kHwServerMaxLines];
+  std::atomic<std::int32_t> digitalOutResult[kHwServerMaxLines];
+  std::atomic<std::uint32_t> analogOutRequest[kHwServerMaxLines];
+  std::atomic<std::uint32_t> analogOutDone[kHwServerMaxLines];
+  std::atomic<std::int32_t> analogOutResult[kHwServerMaxLines];
+  std::atomic<std::uint32_t> writeMessageSeq;  // the board's message for the last refused write (sequence lock)
+  char writeMessage[256];
 };
 
 static_assert(std::atomic<double>::is_always_lock_free && std::atomic<std::int64_t>::is_always_lock_free,

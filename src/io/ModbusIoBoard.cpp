@@ -150,7 +150,9 @@ IoStatus ModbusIoBoard::readAnalogInput(int channel, double& volts) noexcept {
 
 IoStatus ModbusIoBoard::writeAnalogOutput(int channel, double volts) noexcept {
   if (IoStatus s = checkIndex(channel, numAnalogOutputs(), "analog output"); s != IoStatus::kOk) return s;
+  if (IoStatus s = checkVolts(channel, volts); s != IoStatus::kOk) return s;  // NaN cannot become a count
   if (IoStatus s = ensureConnected(); s != IoStatus::kOk) return s;
+  // Clamped to the 16-bit register range (+-32768 counts of voltsPerCount) before the conversion.
   const double counts = std::clamp(std::round(volts / config_.voltsPerCount), -32768.0, 32767.0);
   const auto reg = static_cast<std::uint16_t>(static_cast<std::int16_t>(counts));
   const int address = config_.analogOutputRegisters[static_cast<std::size_t>(channel)];

@@ -104,6 +104,7 @@ IoStatus NetFtClient::sendRequest(Command command, std::uint32_t sampleCount) no
 
 IoStatus NetFtClient::startStreaming(std::uint32_t sampleCount) noexcept {
   haveSequence_ = false;
+  missing_ = 0;
   received_ = lost_ = outOfOrder_ = malformed_ = 0;
   return sendRequest(Command::kStartRealtime, sampleCount);
 }
@@ -145,9 +146,19 @@ IoStatus NetFtClient::receive(NetFtRecord& record, int timeoutMs) noexcept {
         const auto diff = static_cast<std::int32_t>(seq - lastSequence_);  // modulo 2^32 (refdata/08)
         if (diff <= 0) {
           ++outOfOrder_;
+          // A late record whose sequence number was counted as a gap is out of order, not lost.
+          const std::uint32_t back = lastSequence_ - seq;  // 0 = a duplicate of the newest
+          if (back >= 1 && back <= 64 && (missing_ >> (back - 1) & 1u) != 0) {
+            missing_ &= ~(std::uint64_t{1} << (back - 1));
+            --lost_;
+          }
           continue;
         }
         lost_ += static_cast<std::uint64_t>(diff - 1);
+        // Bit i stands for sequence number seq - 1 - i: the old bits move up by diff, the gap
+        // (seq - 1 down to lastSequence_ + 1) fills the lowest diff - 1 bits.
+        const auto gap = static_cast<unsigned>(diff - 1);
+        missing_ = (diff >= 64 ? 0 : missing_ << diff) | (gap >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << gap) - 1);
       }
       haveSequence_ = true;
       lastSequence_ = seq;
@@ -171,7 +182,7 @@ IoStatus NetFtClient::receive(NetFtRecord& record, int timeoutMs) noexcept {
   if (lost_ != lostBefore || outOfOrder_ != outOfOrderBefore)
     return error_.set(IoStatus::kDataLoss, "NetFt %s:%d: %llu records lost, %llu out of order since the last read",
                       config_.address.c_str(), config_.port,
-                      static_cast<unsigned long long>(lost_ - lostBefore),
+                      static_cast<unsigned long long>(lost_ > lostBefore ? lost_ - lostBefore : 0),
                       static_cast<unsigned long long>(outOfOrder_ - outOfOrderBefore));
   return IoStatus::kOk;
 }

@@ -68,6 +68,7 @@ IoStatus SimulatedIoBoard::readAnalogInput(int channel, double& volts) noexcept 
 
 IoStatus SimulatedIoBoard::writeAnalogOutput(int channel, double volts) noexcept {
   if (IoStatus s = checkIndex(channel, config_.analogOutputs, "analog output"); s != IoStatus::kOk) return s;
+  if (IoStatus s = checkVolts(channel, volts); s != IoStatus::kOk) return s;
   const double clamped = std::clamp(volts, -config_.analogRange, config_.analogRange);
   analogOut_[channel].store(clamped);
   if (config_.loopback && channel < config_.analogInputs) analogIn_[channel].store(clamped);

@@ -36,6 +36,31 @@ TEST_F(BarrettHandTest, InitialisesThenClosesOpensAndRelaxes) {
   EXPECT_EQ(reply, "{\"state\": \"relaxed\", \"positions\": [0, 0, 0, 0]}");
 }
 
+TEST_F(BarrettHandTest, ReadingDoesNotInitialiseTheHandOnlyInitializeDoes) {
+  auto* g = om_.createDerivedObject<BarrettHand>("hand");
+  std::string reply;
+  ASSERT_TRUE(g->handleMessage("read", "", reply));
+  EXPECT_EQ(reply, "{\"state\": \"unknown\", \"positions\": [0, 0, 0, 0]}") << reply;
+  ASSERT_TRUE(g->handleMessage("read", "", reply));
+  EXPECT_EQ(hand_.commands(), (std::vector<std::string>{"FGET P", "FGET P"})) << "no HI: it moves every finger";
+  g->executeCommand("Initialize");
+  EXPECT_EQ(g->getErrorCode(), 0) << g->getErrorStatus().message;
+  EXPECT_EQ(hand_.commands().back(), "HI");
+}
+
+TEST(BarrettHand, SectionWithoutPortIsAConfigurationError) {
+  RoboticPlatform::setConfiguration(
+      Configuration::parse("# a hand\n[hand]\nclass BarrettHand\nsimulationMode off\nbaud 9600\n", "t.cfg"));
+  ObjectManager om;
+  try {
+    om.createDerivedObject<Gripper>("hand");
+    FAIL() << "created without a port";
+  } catch (const ConfigError& e) {
+    EXPECT_TRUE(contains(e.what(), "t.cfg:2")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "[hand] has no 'port' setting")) << e.what();
+  }
+}
+
 TEST_F(BarrettHandTest, ErrReplyBecomesTheErrorStatus) {
   auto* g = om_.createDerivedObject<BarrettHand>("hand");
   ASSERT_TRUE(g->initialize()) << g->getErrorStatus().message;

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <thread>
 
@@ -61,6 +62,23 @@ TEST(ArmIoBoard, UnsupportedArmFallsAndGravityCompensationInVoltsHoldsIt) {
   held.advance(0.5);
   EXPECT_LT((held.position() - qz).norm(), 1e-6);
   EXPECT_GT(std::abs(g[1]), 1.0) << "the test is meaningful only with a real load";
+}
+
+TEST(ArmIoBoard, DacsRefuseNaNAndClampToTheirRange) {
+  Puma560Model puma;
+  const JointVector q0 = puma.getHomePosition();
+  ArmIoBoard nan(puma, offline(q0)), zero(puma, offline(q0)), inf(puma, offline(q0)), ten(puma, offline(q0));
+  EXPECT_EQ(nan.writeAnalogOutput(0, std::nan("")), IoStatus::kInvalidValue);
+  ASSERT_EQ(inf.writeAnalogOutput(0, std::numeric_limits<double>::infinity()), IoStatus::kOk);
+  ASSERT_EQ(ten.writeAnalogOutput(0, 10.0), IoStatus::kOk);  // the DAC range
+  for (ArmIoBoard* b : {&nan, &zero, &inf, &ten}) {
+    b->writeDigitalOutput(0, true);
+    b->advance(0.05);
+  }
+  EXPECT_TRUE(nan.position().allFinite()) << "NaN never reached the arm";
+  EXPECT_EQ(nan.position(), zero.position()) << "the NaN write left the DAC at 0 V";
+  EXPECT_GT(inf.position()[0], q0[0]);
+  EXPECT_EQ(inf.position()[0], ten.position()[0]) << "infinity clamped to +10 V";
 }
 
 TEST(RpHwServer, PumaBackendMovesTheArmOnDacVolts) {

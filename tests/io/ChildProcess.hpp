@@ -20,12 +20,14 @@ namespace rp::test {
 
 class ChildProcess {
  public:
-  explicit ChildProcess(const std::vector<std::string>& argv) {
+  // mergeStderr: the child's stderr goes to the same pipe as its stdout (readLine sees both).
+  explicit ChildProcess(const std::vector<std::string>& argv, bool mergeStderr = false) {
     int fds[2];
     if (::pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
+    if (mergeStderr) posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);

@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <string>
 #include <thread>
 
@@ -54,6 +56,25 @@ TEST(HwServer, ServesABoardToSeveralClients) {
   EXPECT_EQ(a.readDigitalInput(0, on), IoStatus::kNotConnected);
   EXPECT_TRUE(contains(a.lastError(), "has stopped")) << a.lastError();
   EXPECT_TRUE(board.readDigitalOutput(2, on) == IoStatus::kOk && !on) << "outputs off when the server stops";
+}
+
+TEST(HwServer, ClientRefusesNaNAndTheServersBoardClamps) {
+  SimulatedIoBoard board({.digitalInputs = 0, .digitalOutputs = 0, .analogInputs = 0, .analogOutputs = 2,
+                          .encoders = 0, .analogRange = 10.0, .loopback = false});
+  HwServer server(board, uniqueName("nan"), 500.0);
+  server.start();
+  HwServerIoBoard client(server.name());
+  ASSERT_EQ(client.writeAnalogOutput(0, 3.0), IoStatus::kOk);
+  EXPECT_EQ(client.writeAnalogOutput(0, std::nan("")), IoStatus::kInvalidValue);
+  ASSERT_EQ(client.writeAnalogOutput(1, -std::numeric_limits<double>::infinity()), IoStatus::kOk);
+  ASSERT_EQ(client.confirmWrites(5000), IoStatus::kOk) << client.lastError();
+  double v = 0;
+  ASSERT_EQ(board.readAnalogOutput(0, v), IoStatus::kOk);
+  EXPECT_EQ(v, 3.0) << "NaN never reached the server";
+  ASSERT_EQ(client.readAppliedAnalogOutput(1, v), IoStatus::kOk);
+  EXPECT_EQ(v, -std::numeric_limits<double>::infinity()) << "what the board accepted...";
+  ASSERT_EQ(board.readAnalogOutput(1, v), IoStatus::kOk);
+  EXPECT_EQ(v, -10.0) << "... and clamped to its range";
 }
 
 TEST(HwServer, ClientOperationsDoNotAllocate) {

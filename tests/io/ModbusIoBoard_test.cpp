@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "ModbusEmulator.hpp"
@@ -81,6 +83,21 @@ TEST_F(ModbusIoBoardTest, AnalogOutputsWriteScaledHoldingRegisters) {
   EXPECT_EQ(static_cast<std::int16_t>(server_.holdingRegister(6)), -2500);
   ASSERT_EQ(board.writeAnalogOutput(0, 100.0), IoStatus::kOk);  // beyond 16 bits: clamped
   EXPECT_EQ(static_cast<std::int16_t>(server_.holdingRegister(4)), 32767);
+}
+
+TEST_F(ModbusIoBoardTest, AnalogOutputsRefuseNaNAndClampToTheRegisterRange) {
+  ModbusIoBoard board(boardConfig(server_.port()));
+  ASSERT_EQ(board.writeAnalogOutput(0, 1.25), IoStatus::kOk) << board.lastError();
+  EXPECT_EQ(board.writeAnalogOutput(0, std::nan("")), IoStatus::kInvalidValue);
+  EXPECT_TRUE(contains(board.lastError(), "NaN volts refused")) << board.lastError();
+  EXPECT_EQ(static_cast<std::int16_t>(server_.holdingRegister(4)), 1250) << "the register keeps its value";
+  EXPECT_TRUE(board.isConnected());
+  ASSERT_EQ(board.writeAnalogOutput(0, -std::numeric_limits<double>::infinity()), IoStatus::kOk);
+  EXPECT_EQ(static_cast<std::int16_t>(server_.holdingRegister(4)), -32768);
+  ASSERT_EQ(board.writeAnalogOutput(1, std::numeric_limits<double>::infinity()), IoStatus::kOk);
+  EXPECT_EQ(static_cast<std::int16_t>(server_.holdingRegister(6)), 32767);
+  ASSERT_EQ(board.writeAnalogOutput(1, -1e300), IoStatus::kOk);
+  EXPECT_EQ(static_cast<std::int16_t>(server_.holdingRegister(6)), -32768);
 }
 
 TEST_F(ModbusIoBoardTest, AddressOutsideTheDeviceIsADeviceError) {

@@ -146,10 +146,25 @@ TEST_F(NetFtClientTest, DetectsReorderedRecords) {
   drain(r, 13);
   NetFtRecord stale;
   EXPECT_EQ(client_->receive(stale, 100), IoStatus::kTimeout) << "record 12, sent after 13, is never delivered";
-  // Record 4 arrives after record 5 (likewise 8, 12): counted as out of order, and as a gap first.
+  // Record 4 arrives after record 5 (likewise 8, 12): out of order, and no longer lost once it came.
   EXPECT_EQ(client_->outOfOrderRecords(), 3u);
-  EXPECT_EQ(client_->lostRecords(), 3u);
+  EXPECT_EQ(client_->lostRecords(), 0u);
+  EXPECT_EQ(client_->receivedRecords(), 10u);
   EXPECT_EQ(r.rdtSequence, 13u);
+}
+
+TEST_F(NetFtClientTest, LostAndReorderedRecordsAreCountedOnceEach) {
+  sensor_.setFaults({.dropEvery = 5, .reorderEvery = 3});
+  ASSERT_EQ(client_->startStreaming(16), IoStatus::kOk);
+  NetFtRecord r;
+  drain(r, 16);
+  NetFtRecord stale;
+  client_->receive(stale, 100);  // the last held record, if any
+  // Arrival order: 1 2 4 3 7 6 8 9 11 13 12 14 16. Dropped: 5, 10 and 15 (dropping wins over
+  // holding back; 9, held while 10 was dropped, still comes before 11). Late: 3, 6 and 12.
+  EXPECT_EQ(client_->lostRecords(), 3u);
+  EXPECT_EQ(client_->outOfOrderRecords(), 3u);
+  EXPECT_EQ(client_->receivedRecords(), 10u);
 }
 
 TEST_F(NetFtClientTest, GarbledAndTruncatedDatagramsAreDiscarded) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "AllocationCounter.hpp"
@@ -9,6 +11,25 @@
 
 namespace rp {
 namespace {
+
+TEST(SimulatedIoBoard, AnalogOutputsRefuseNaNAndClampInfinities) {
+  SimulatedIoBoard board({.digitalInputs = 0, .digitalOutputs = 0, .analogInputs = 1, .analogOutputs = 1,
+                          .encoders = 0, .analogRange = 5.0, .loopback = true});
+  double v = 0;
+  ASSERT_EQ(board.writeAnalogOutput(0, 1.5), IoStatus::kOk);
+  EXPECT_EQ(board.writeAnalogOutput(0, std::nan("")), IoStatus::kInvalidValue);
+  EXPECT_STREQ(board.lastError(), "analog output 0: NaN volts refused (nothing written)");
+  ASSERT_EQ(board.readAnalogOutput(0, v), IoStatus::kOk);
+  EXPECT_EQ(v, 1.5) << "the output keeps its value";
+  ASSERT_EQ(board.readAnalogInput(0, v), IoStatus::kOk);
+  EXPECT_EQ(v, 1.5) << "and the loopback input too";
+  ASSERT_EQ(board.writeAnalogOutput(0, std::numeric_limits<double>::infinity()), IoStatus::kOk);
+  ASSERT_EQ(board.readAnalogOutput(0, v), IoStatus::kOk);
+  EXPECT_EQ(v, 5.0);
+  ASSERT_EQ(board.writeAnalogOutput(0, -std::numeric_limits<double>::infinity()), IoStatus::kOk);
+  ASSERT_EQ(board.readAnalogOutput(0, v), IoStatus::kOk);
+  EXPECT_EQ(v, -5.0);
+}
 
 TEST(SimulatedIoBoard, OutputsKeepTheirValueAndInputsFollowTheSimulation) {
   SimulatedIoBoard board({.digitalInputs = 4, .digitalOutputs = 3, .analogInputs = 2, .analogOutputs = 2,

@@ -13,21 +13,23 @@ namespace rp {
 
 /// The BarrettHand (paper section 3.4, reference [16]) on a serial port: 9600 baud 8N1, the
 /// supervisory command protocol of `BarrettHandSerial`. In hardware mode the hand is initialised
-/// with `HI` on first use; `open()` sends `GO`, `close()` `GC`, `relax()` the hand's own
+/// with `HI` (a calibration move of every finger) before its first motion command, never for a
+/// reading; `open()` sends `GO`, `close()` `GC`, `relax()` the hand's own
 /// terminate command `T` (motors off). Every command waits for the `=> ` prompt within a bounded
 /// time and turns an `ERR` reply into the object's error status.
 ///
 /// Also registers the command `Initialize` (sends `HI` again). The message `read` answers
-/// `{"state": ..., "positions": [f1, f2, f3, spread]}` (encoder counts; hardware only).
+/// `{"state": ..., "positions": [f1, f2, f3, spread]}` (encoder counts; hardware only); it opens
+/// the port if needed but does not initialise the hand.
 ///
-/// rp.cfg settings (besides Gripper's): `port DEVICE` (serial port, e.g. `/dev/ttyS0`),
+/// rp.cfg settings (besides Gripper's): `port DEVICE` (serial port, e.g. `/dev/ttyS0`; required),
 /// `baud N` (default 9600), `timeout MS` (prompt wait, default 1000), `motionTimeout MS`
 /// (for HI, GO, GC; default 10000).
 class BarrettHand : public Gripper {
  public:
   /// Creates the hand (the port is opened on first use, in hardware mode).
   /// @param[in] name  object name (rp.cfg section); empty for an automatic name
-  /// @throws ConfigError if a setting is invalid
+  /// @throws ConfigError if a setting is invalid or `port` is missing from its rp.cfg section
   /// Real-time safe: no.
   explicit BarrettHand(const std::string& name = "");
   ~BarrettHand() override;
@@ -40,7 +42,7 @@ class BarrettHand : public Gripper {
   /// @return true on success; false on failure (see getErrorStatus())
   /// Real-time safe: no.
   bool initialize();
-  /// Reads the finger and spread positions (`FGET P`).
+  /// Reads the finger and spread positions (`FGET P`); opens the port if needed, never sends `HI`.
   /// @param[out] counts  encoder counts of fingers 1, 2, 3 and the spread
   /// @return true on success; false on failure or in simulation
   /// Real-time safe: no.
@@ -56,6 +58,7 @@ class BarrettHand : public Gripper {
 
  private:
   bool ready();
+  bool opened();
   bool check(IoStatus status);
 
   BarrettHandSerial::Config config_;

@@ -25,15 +25,33 @@ struct HwServerShm;
 /// The segment is `/dev/shm/rp-hwserver-<name>`; it is created by `start()` and removed by
 /// `stop()`. Each cycle also publishes a heartbeat (monotonic time), the cycle count and the
 /// board's status, so clients notice a server that died or a board that failed.
+///
+/// Client watchdog: every output line belongs to the client that wrote it last, and every client
+/// publishes a heartbeat of its own (`HwServerIoBoard`). When a client falls silent for longer
+/// than the watchdog time (killed, stopped, hung) while one of its outputs is on, or detaches, or
+/// its process is gone, the server writes its outputs off (digital false, analog 0 V) in its next
+/// cycle: within watchdog time + one period of the client's last operation. A silent client
+/// that wakes up again finds its writes refused (`kNotConnected`) until it attaches anew, so it
+/// cannot switch amplifiers back on with stale commands.
+///
+/// Writes are acknowledged: the server reports the board's answer to each written line (see
+/// `HwServerIoBoard::confirmWrites()`). A write the board refuses (`kDeviceError`,
+/// `kInvalidLine`, `kNotSupported`) is reported to that line only and the cycle goes on; a
+/// connection failure (`kNotConnected`, `kTimeout`, `kProtocolError`) ends the cycle, is
+/// reported to every pending write and becomes the board status.
 class HwServer {
  public:
   /// Creates the server for a board (not yet started).
   /// @param[in] board  the board to serve; must outlive the server; at most 64 lines of each kind are served
   /// @param[in] name  server name: letters, digits, '-', '_' and '.', 1 to 64 characters
   /// @param[in] rateHz  I/O rate [Hz], 1 .. 10000
-  /// @throws IoException if the name or rate is invalid
+  /// @param[in] watchdogMs  a client silent for longer than this [ms] has its outputs switched off, 1 .. 60000
+  /// @throws IoException if the name, rate or watchdog time is invalid
   /// Real-time safe: no.
-  HwServer(IoBoard& board, const std::string& name, double rateHz);
+  HwServer(IoBoard& board, const std::string& name, double rateHz, double watchdogMs = kDefaultWatchdogMs);
+
+  /// The default client watchdog time [ms] (`rp-hwserver -watchdog MS` changes it).
+  static constexpr double kDefaultWatchdogMs = 50.0;
   /// Stops the server if it is running.
   ~HwServer();
   HwServer(const HwServer&) = delete;             ///< not copyable
@@ -59,19 +77,42 @@ class HwServer {
   /// Status of the board in the last cycle (`kOk`, or the first failure of that cycle).
   /// Real-time safe: yes.
   IoStatus boardStatus() const noexcept;
+  /// The client watchdog time [ms].
+  /// Real-time safe: yes.
+  double watchdogMs() const noexcept { return watchdogMs_; }
+  /// How many times the watchdog switched off the outputs of a silent client so far.
+  /// Real-time safe: yes.
+  std::uint64_t watchdogTrips() const noexcept;
+  /// The process id of the last client the watchdog cut off, and how long it had been silent [ms]
+  /// (both 0 before the first trip); read after `watchdogTrips()` changed, to log it.
+  /// @param[out] silenceMs  how long that client had been silent [ms]
+  /// @return its process id
+  /// Real-time safe: yes.
+  int lastWatchdogTrip(double& silenceMs) const noexcept;
 
  private:
   void run();
   void cycle(bool writeAll);
+  void watchClients(std::int64_t now);
+  bool ownsOutputThatIsOn(int slot) const noexcept;
+  template <typename T>
+  bool forceOffIfOrphaned(std::atomic<T>& value, std::atomic<std::int8_t>& owner, T& v) noexcept;
+  void reportWrite(std::atomic<std::uint32_t>& done, std::atomic<std::int32_t>& result, std::uint32_t request,
+                   IoStatus status) noexcept;
 
   IoBoard& board_;
   std::string name_;
   double rateHz_;
+  double watchdogMs_;
   internal::HwServerShm* shm_ = nullptr;
   int counts_[5] = {0, 0, 0, 0, 0};
   bool lastDigitalOut_[64] = {};
   double lastAnalogOut_[64] = {};
-  std::uint64_t finalCycles_ = 0, finalOverruns_ = 0;  // kept when the segment is gone
+  IoStatus lastDigitalResult_[64] = {};  // the board's answer to the last write of each line
+  IoStatus lastAnalogResult_[64] = {};
+  std::uint64_t finalCycles_ = 0, finalOverruns_ = 0, finalTrips_ = 0;  // kept when the segment is gone
+  int finalTripPid_ = 0;
+  std::int64_t finalTripSilenceNs_ = 0;
   std::atomic<bool> stopRequested_{false};
   std::thread thread_;
 };

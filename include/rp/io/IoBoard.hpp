@@ -71,7 +71,8 @@ class IoBoard {
   /// Sets an analog output channel.
   /// @param[in] channel  0 .. numAnalogOutputs()-1
   /// @param[in] volts  the output voltage [V]; the implementation clamps it to its range
-  /// @return `kOk`, `kInvalidLine`, or a communication error
+  /// @return `kOk`, `kInvalidLine`, `kInvalidValue` (NaN: refused, the output keeps its value),
+  ///         or a communication error
   /// Real-time safe: depends on the implementation.
   virtual IoStatus writeAnalogOutput(int channel, double volts) noexcept = 0;
 
@@ -81,6 +82,17 @@ class IoBoard {
   /// @return `kOk`, `kInvalidLine`, or a communication error
   /// Real-time safe: depends on the implementation.
   virtual IoStatus readEncoder(int encoder, std::int64_t& counts) noexcept = 0;
+
+  /// Waits until the outputs written so far reached the device and returns its answer. Boards
+  /// that write synchronously (every board but `HwServerIoBoard`) have nothing to wait for: each
+  /// write already returned the device's answer.
+  /// @param[in] timeoutMs  the longest wait [ms]
+  /// @return `kOk`, or the failure of one of the writes, or `kTimeout`
+  /// Real-time safe: depends on the implementation (`HwServerIoBoard`: no, it sleeps).
+  virtual IoStatus confirmWrites(int timeoutMs) noexcept {
+    (void)timeoutMs;
+    return IoStatus::kOk;
+  }
 
   /// Status of the last failed operation (`kOk` if none failed yet).
   /// Real-time safe: yes.
@@ -104,6 +116,17 @@ class IoBoard {
   IoStatus checkIndex(int index, int count, const char* what) noexcept {
     if (index >= 0 && index < count) return IoStatus::kOk;
     return error_.set(IoStatus::kInvalidLine, "%s %d out of range (board has %d)", what, index, count);
+  }
+
+  /// Checks a voltage for an analog output: NaN is refused (`kInvalidValue`, nothing is written);
+  /// every other value, infinities too, is then clamped to the board's range by the caller.
+  /// @param[in] channel  the analog output, for the message
+  /// @param[in] volts  the voltage to check
+  /// @return `kOk` or `kInvalidValue`
+  /// Real-time safe: yes.
+  IoStatus checkVolts(int channel, double volts) noexcept {
+    if (volts == volts) return IoStatus::kOk;  // false only for NaN
+    return error_.set(IoStatus::kInvalidValue, "analog output %d: NaN volts refused (nothing written)", channel);
   }
 };
 

@@ -17,7 +17,8 @@ enum class IoStatus {
   kProtocolError,  ///< the reply was garbled, truncated or otherwise did not follow the protocol
   kDeviceError,    ///< the device answered with an error of its own (for example a BarrettHand `ERR` reply)
   kDataLoss,       ///< data arrived, but some was lost or out of order (for example UDP records)
-  kNotSupported    ///< the board or device does not offer this operation
+  kNotSupported,   ///< the board or device does not offer this operation
+  kInvalidValue    ///< a value the operation cannot take (for example NaN volts); nothing was written
 };
 
 /// Name of a status code, for messages and logs, for example `"timeout"`.
@@ -34,6 +35,7 @@ constexpr const char* toString(IoStatus status) noexcept {
     case IoStatus::kDeviceError: return "device error";
     case IoStatus::kDataLoss: return "data loss";
     case IoStatus::kNotSupported: return "not supported";
+    case IoStatus::kInvalidValue: return "invalid value";
   }
   return "unknown";
 }

@@ -29,7 +29,9 @@ struct NetFtRecord {
 /// torques counts / countsPerTorque.
 ///
 /// The RDT sequence number detects lost and reordered datagrams: a gap adds to `lostRecords()`,
-/// a record older than the newest one is counted in `outOfOrderRecords()` and discarded.
+/// a record older than the newest one is counted in `outOfOrderRecords()` and discarded. A record
+/// that arrives late fills its gap: it is counted as out of order, not as lost as well (for the 64
+/// sequence numbers below the newest; an older straggler stays counted as lost too).
 /// Datagrams that are not a whole number of 36-byte records are counted in `malformedPackets()`.
 ///
 /// `receive()` with a zero timeout never blocks and does not allocate, so a servo loop may call
@@ -120,7 +122,7 @@ class NetFtClient {
   /// Records received and accepted in order since startStreaming().
   /// Real-time safe: yes.
   std::uint64_t receivedRecords() const noexcept { return received_; }
-  /// Records missing from the sequence (gaps) since startStreaming().
+  /// Records missing from the sequence (gaps not filled by a late record) since startStreaming().
   /// Real-time safe: yes.
   std::uint64_t lostRecords() const noexcept { return lost_; }
   /// Records that arrived after a newer one since startStreaming() (discarded).
@@ -142,6 +144,7 @@ class NetFtClient {
   int fd_ = -1;
   bool haveSequence_ = false;
   std::uint32_t lastSequence_ = 0;
+  std::uint64_t missing_ = 0;  // bit i: sequence lastSequence_ - 1 - i was counted lost
   std::uint64_t received_ = 0, lost_ = 0, outOfOrder_ = 0, malformed_ = 0;
   DeviceError error_;
 };

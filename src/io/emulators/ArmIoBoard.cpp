@@ -92,6 +92,7 @@ IoStatus ArmIoBoard::readAnalogInput(int channel, double&) noexcept { return che
 
 IoStatus ArmIoBoard::writeAnalogOutput(int channel, double volts) noexcept {
   if (IoStatus s = checkIndex(channel, n_, "analog output"); s != IoStatus::kOk) return s;
+  if (IoStatus s = checkVolts(channel, volts); s != IoStatus::kOk) return s;
   catchUp();
   std::lock_guard lock(mutex_);
   volts_[channel] = std::clamp(volts, -config_.dacRange, config_.dacRange);

@@ -26,7 +26,8 @@ void checkAddress(int address, int count, const char* what) {
 
 ModbusEmulator::ModbusEmulator() : ModbusEmulator(Config{}) {}
 
-ModbusEmulator::ModbusEmulator(const Config& config) : config_(config) {
+ModbusEmulator::ModbusEmulator(const Config& config)
+    : config_(config), switchedOn_(static_cast<std::size_t>(config.coils > 0 ? config.coils : 0), 0) {
   mapping_ = modbus_mapping_new(config.coils, config.discreteInputs, config.holdingRegisters, config.inputRegisters);
   if (mapping_ == nullptr) throw std::runtime_error("ModbusEmulator: cannot allocate the register mapping");
 }
@@ -96,7 +97,11 @@ void ModbusEmulator::serve() {
       switch (fault_.load()) {
         case Fault::kNone: {
           std::lock_guard lock(mutex_);
-          modbus_reply(asCtx(ctx_), query, rc, asMap(mapping_));
+          auto* map = asMap(mapping_);
+          const std::vector<std::uint8_t> before(map->tab_bits, map->tab_bits + config_.coils);
+          modbus_reply(asCtx(ctx_), query, rc, map);
+          for (int c = 0; c < config_.coils; ++c)
+            if (before[static_cast<std::size_t>(c)] == 0 && map->tab_bits[c] != 0) ++switchedOn_[static_cast<std::size_t>(c)];
           break;
         }
         case Fault::kSilent:
@@ -116,6 +121,12 @@ void ModbusEmulator::serve() {
     }
   }
   for (int c : clients) ::close(c);
+}
+
+long ModbusEmulator::coilSwitchedOn(int address) const {
+  std::lock_guard lock(mutex_);
+  checkAddress(address, config_.coils, "coil");
+  return switchedOn_[static_cast<std::size_t>(address)];
 }
 
 bool ModbusEmulator::coil(int address) const {

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace rp::emulator {
 
@@ -38,6 +39,8 @@ class ModbusEmulator {
   int port() const { return port_; }
 
   bool coil(int address) const;
+  // How many times a request switched the coil from off to on.
+  long coilSwitchedOn(int address) const;
   void setCoil(int address, bool value);
   void setDiscreteInput(int address, bool value);
   std::uint16_t holdingRegister(int address) const;
@@ -58,6 +61,7 @@ class ModbusEmulator {
   std::atomic<bool> stopRequested_{false};
   std::atomic<Fault> fault_{Fault::kNone};
   std::atomic<long> requests_{0};
+  std::vector<long> switchedOn_;  // per coil, under mutex_
   std::thread thread_;
 };
 
