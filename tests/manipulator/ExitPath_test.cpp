@@ -1,15 +1,25 @@
 // However a program ends, the exit status says how, a shutdown in progress is completed first,
 // and the log of it is on stderr: a real program (exit_child) with a moving Puma, ended by a
-// return, a fault, an exception in calculate(), SIGINT, SIGTERM and an uncaught exception.
+// return, a fault, an exception in calculate(), SIGINT, SIGTERM and an uncaught exception. Then
+// the same exits with the Puma behind a hardware server (rp-hwserver -board puma560): after each
+// the server's applied outputs are read as another client would: the amplifiers off and 0 V on
+// every joint, switched off by the program itself (the server's watchdog did not have to), except
+// after SIGKILL, where the watchdog does it.
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "ChildProcess.hpp"
 #include "rp/core/RoboticPlatform.hpp"
+#include "rp/io/HwServerIoBoard.hpp"
 
 namespace rp {
 namespace {
@@ -79,6 +89,71 @@ TEST(ExitPath, AnUncaughtExceptionEndsWithStatus1AndItsMessage) {
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_TRUE(has(r, "error: the work piece is not where it should be")) << r.output;
 }
+
+// The Puma behind `rp-hwserver -board puma560`, for each way a program ends.
+class HardwareExitPath : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    name_ = "exit-" + std::to_string(::getpid());
+    dir_ = std::filesystem::temp_directory_path() / ("rp-" + name_);
+    std::filesystem::create_directories(dir_);
+    std::ofstream(dir_ / "rp.cfg") << "[puma]\nclass Puma560\nsimulationMode off\nhwserver " << name_ << "\n";
+    server_ = std::make_unique<test::ChildProcess>(
+        std::vector<std::string>{RP_HWSERVER_PATH, "-name", name_, "-rate", "1000", "-board", "puma560"});
+    ASSERT_TRUE(server_->readLine(10000).has_value()) << "the server did not start";
+    monitor_ = std::make_unique<HwServerIoBoard>(name_);
+  }
+  void TearDown() override {
+    monitor_.reset();
+    server_.reset();
+    std::filesystem::remove_all(dir_);
+  }
+
+  bool outputsOff() {
+    bool enable = true;
+    if (monitor_->readAppliedDigitalOutput(0, enable) != IoStatus::kOk || enable) return false;
+    for (int j = 0; j < 6; ++j) {
+      double volts = 1;
+      if (monitor_->readAppliedAnalogOutput(j, volts) != IoStatus::kOk || volts != 0.0) return false;
+    }
+    return true;
+  }
+  // Waits (generously: the machine may be loaded) until the outputs are off.
+  bool waitUntilOff() {
+    for (int i = 0; i < 5000; ++i) {
+      if (outputsOff()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return false;
+  }
+
+  // Runs exit_child in `mode` against the server; `sig` is sent once it is ready. Checks that the
+  // amplifiers were on while it ran, its exit status, and the outputs after it.
+  void run(const std::string& mode, int sig, int status) {
+    const std::uint64_t tripsBefore = monitor_->watchdogTrips();
+    ChildRun r = runChild(mode, sig, {"-nosim", "-config", (dir_ / "rp.cfg").string()});
+    EXPECT_EQ(r.status, status) << mode << ":\n" << r.output;
+    EXPECT_TRUE(waitUntilOff()) << mode << ": the amplifiers or a DAC are still on after the program ended";
+    if (sig == SIGKILL) {
+      EXPECT_EQ(monitor_->watchdogTrips(), tripsBefore + 1) << "the server's watchdog switched the outputs off";
+    } else {
+      EXPECT_EQ(monitor_->watchdogTrips(), tripsBefore) << mode << ": the program left its outputs on for the watchdog";
+    }
+  }
+
+  std::string name_;
+  std::filesystem::path dir_;
+  std::unique_ptr<test::ChildProcess> server_;
+  std::unique_ptr<HwServerIoBoard> monitor_;
+};
+
+TEST_F(HardwareExitPath, Return) { run("return", 0, 0); }
+TEST_F(HardwareExitPath, LimitShutdown) { run("fault", 0, RoboticPlatform::kExitAfterShutdown); }
+TEST_F(HardwareExitPath, ExceptionInCalculate) { run("throw", 0, RoboticPlatform::kExitAfterShutdown); }
+TEST_F(HardwareExitPath, Sigint) { run("signal", SIGINT, 128 + SIGINT); }
+TEST_F(HardwareExitPath, Sigterm) { run("signal", SIGTERM, 128 + SIGTERM); }
+TEST_F(HardwareExitPath, Sigkill) { run("signal", SIGKILL, 128 + SIGKILL); }
+TEST_F(HardwareExitPath, UncaughtException) { run("uncaught", 0, 1); }
 
 }  // namespace
 }  // namespace rp
