@@ -16,6 +16,7 @@
 #include <cstring>
 #include <map>
 #include <numbers>
+#include <unordered_map>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -191,12 +192,7 @@ bool finiteTriple(const TiXmlElement* e, const char* name) {
 
 // Checks every link's <inertial> in the XML itself: urdfdom drops an inertial it cannot parse
 // (mass="nan", a missing inertia attribute) with a message on stderr and loads a massless link.
-void checkInertials(const std::string& text, const std::string& fileName) {
-  TiXmlDocument doc;
-  doc.Parse(text.c_str());
-  if (doc.Error()) return;  // urdfdom reports malformed XML
-  const TiXmlElement* robot = doc.FirstChildElement("robot");
-  if (!robot) return;
+void checkInertials(const TiXmlElement* robot, const std::string& fileName) {
   for (const TiXmlElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link")) {
     const TiXmlElement* inertial = link->FirstChildElement("inertial");
     if (!inertial) continue;
@@ -228,9 +224,76 @@ void checkInertials(const std::string& text, const std::string& fileName) {
   }
 }
 
-// Refuses a robot whose links do not form one tree under the root: a link that is the child of
-// two joints, or links that cannot be reached from the root (both only with a kinematic loop).
-// urdfdom accepts both, and walking such a robot never ends.
+constexpr const char* kLoop = ": a kinematic loop; a manipulator's links must form a tree";
+
+// Checks in the XML that the joints link the links into one tree, before urdfdom builds it:
+// urdfdom accepts a kinematic loop (and walking it never ends), and when it fails half-way
+// (a second root, a joint naming an unknown link) it leaks a loop's links and frees a long chain
+// with one recursive call per link.
+void checkJointGraph(const TiXmlElement* robot, const std::string& fileName) {
+  std::vector<std::string> links;  // in file order
+  std::unordered_set<std::string> defined;
+  for (const TiXmlElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link")) {
+    const char* name = link->Attribute("name");
+    if (name && defined.insert(name).second) links.emplace_back(name);
+  }
+  std::unordered_map<std::string, std::pair<std::string, std::string>> parentOf;  // link -> (parent link, joint)
+  for (const TiXmlElement* joint = robot->FirstChildElement("joint"); joint; joint = joint->NextSiblingElement("joint")) {
+    const char* nameAttribute = joint->Attribute("name");
+    const std::string name = nameAttribute ? nameAttribute : "";
+    const TiXmlElement* parentElement = joint->FirstChildElement("parent");
+    const TiXmlElement* childElement = joint->FirstChildElement("child");
+    const char* parent = parentElement ? parentElement->Attribute("link") : nullptr;
+    const char* child = childElement ? childElement->Attribute("link") : nullptr;
+    const std::string where = fileName + ": joint '" + excerpt(name) + "'";
+    if (!parent || !*parent) throw UrdfError(where + " has no parent link");
+    if (!child || !*child) throw UrdfError(where + " has no child link");
+    for (const char* link : {parent, child})
+      if (!defined.count(link)) throw UrdfError(where + ": there is no link '" + excerpt(link) + "'");
+    const auto [it, added] = parentOf.emplace(child, std::make_pair(std::string(parent), name));
+    if (!added)
+      throw UrdfError(fileName + ": link '" + excerpt(child) + "' is the child of two joints ('" +
+                      excerpt(it->second.second) + "' and '" + excerpt(name) + "')" + kLoop);
+  }
+  std::vector<const std::string*> roots;
+  for (const std::string& link : links)
+    if (!parentOf.count(link)) roots.push_back(&link);
+  if (roots.empty() && !links.empty())
+    throw UrdfError(fileName + ": there is no root link (every link is the child of a joint)" + kLoop);
+  if (roots.size() > 1)
+    throw UrdfError(fileName + ": links '" + excerpt(*roots[0]) + "' and '" + excerpt(*roots[1]) +
+                    "' both have no parent joint; a robot has one root link");
+  // Every link must reach the root through its parents; a walk that comes back to a link of its
+  // own is a loop. Links found to reach the root are remembered, so each link is walked once.
+  std::unordered_set<std::string> reachesRoot;
+  if (!roots.empty()) reachesRoot.insert(*roots[0]);
+  std::unordered_set<std::string> walk;
+  for (const std::string& start : links) {
+    walk.clear();
+    std::string link = start;
+    while (!reachesRoot.count(link)) {
+      if (!walk.insert(link).second)
+        throw UrdfError(fileName + ": link '" + excerpt(start) + "' cannot be reached from the root link '" +
+                        excerpt(*roots[0]) + "'" + kLoop);
+      link = parentOf.at(link).first;
+    }
+    reachesRoot.insert(walk.begin(), walk.end());
+  }
+}
+
+// The checks that need the XML itself (see checkInertials() and checkJointGraph()).
+void checkDocument(const std::string& text, const std::string& fileName) {
+  TiXmlDocument doc;
+  doc.Parse(text.c_str());
+  if (doc.Error()) return;  // urdfdom reports malformed XML
+  const TiXmlElement* robot = doc.FirstChildElement("robot");
+  if (!robot) return;  // and a missing <robot>
+  checkInertials(robot, fileName);
+  checkJointGraph(robot, fileName);
+}
+
+// The same for the model urdfdom built (a second line of defence: urdfdom might read the XML
+// differently): one tree under the root.
 void checkTree(const urdf::ModelInterface& robot, const urdf::Link& root, const std::string& fileName) {
   std::map<std::string, std::string> parentJoint;  // child link -> joint
   for (const auto& [name, joint] : robot.joints_) {
@@ -238,8 +301,7 @@ void checkTree(const urdf::ModelInterface& robot, const urdf::Link& root, const 
     const auto [it, added] = parentJoint.emplace(joint->child_link_name, name);
     if (!added)
       throw UrdfError(fileName + ": link '" + excerpt(joint->child_link_name) + "' is the child of two joints ('" +
-                      excerpt(it->second) + "' and '" + excerpt(name) +
-                      "'): a kinematic loop; a manipulator's links must form a tree");
+                      excerpt(it->second) + "' and '" + excerpt(name) + "')" + kLoop);
   }
   std::unordered_set<const urdf::Link*> seen{&root};
   std::vector<const urdf::Link*> todo{&root};
@@ -252,7 +314,7 @@ void checkTree(const urdf::ModelInterface& robot, const urdf::Link& root, const 
   for (const auto& [name, link] : robot.links_)
     if (link && !seen.count(link.get()))
       throw UrdfError(fileName + ": link '" + excerpt(name) + "' cannot be reached from the root link '" +
-                      excerpt(root.name) + "': a kinematic loop; a manipulator's links must form a tree");
+                      excerpt(root.name) + "'" + kLoop);
 }
 
 // Whether every number of a pose is finite.
@@ -278,7 +340,7 @@ struct UnlinkOnExit {
 std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options) {
   const std::string text = readUrdfFile(fileName);
   checkNesting(text, fileName);
-  checkInertials(text, fileName);
+  checkDocument(text, fileName);
   const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text);
   if (!robot) throw UrdfError(fileName + ": not a valid URDF document (malformed XML or URDF structure)");
   const UnlinkOnExit unlink{*robot};

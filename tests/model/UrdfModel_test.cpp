@@ -355,6 +355,29 @@ TEST_F(UrdfInputTest, KinematicLoopsAreRefused) {
   tipX.tip = "x";
   EXPECT_EQ(message(island, tipX), island + ": link 'x' cannot be reached from the root link 'r': a kinematic loop; "
                                             "a manipulator's links must form a tree");
+  // Found by rp_urdf_fuzzer: a link that is its own parent next to a joint urdfdom then refused
+  // (its parent element has no link attribute); urdfdom leaked the looped link.
+  const std::string self = write("self.urdf", "<robot name=\"self\"><link name=\"a\"/><link name=\"b\"/>" +
+                                                  joint("j1", "revolute", "a", "b") + joint("j2", "revolute", "b", "b") +
+                                                  "<joint name=\"j3\" type=\"fixed\"><parent lnk=\"b\"/><child link=\"a\"/></joint>"
+                                                  "</robot>");
+  EXPECT_EQ(message(self), self + ": link 'b' is the child of two joints ('j1' and 'j2'): a kinematic loop; "
+                                  "a manipulator's links must form a tree");
+  const std::string noRoot = write("noroot.urdf", "<robot name=\"n\"><link name=\"a\"/>" +
+                                                      joint("j", "revolute", "a", "a") + "</robot>");
+  EXPECT_EQ(message(noRoot), noRoot + ": there is no root link (every link is the child of a joint): a kinematic "
+                                      "loop; a manipulator's links must form a tree");
+}
+
+// What urdfdom would refuse only after building part of the tree is refused before it.
+TEST_F(UrdfInputTest, JointsMustNameDefinedLinksAndOneRoot) {
+  const std::string base = "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/>";
+  std::string f = write("j.urdf", base + joint("j", "revolute", "a", "c") + "</robot>");
+  EXPECT_EQ(message(f), f + ": joint 'j': there is no link 'c'");
+  f = write("j.urdf", base + "<joint name=\"j\" type=\"fixed\"><child link=\"b\"/></joint></robot>");
+  EXPECT_EQ(message(f), f + ": joint 'j' has no parent link");
+  f = write("j.urdf", base + "<link name=\"c\"/>" + joint("j", "revolute", "a", "b") + "</robot>");
+  EXPECT_EQ(message(f), f + ": links 'a' and 'c' both have no parent joint; a robot has one root link");
 }
 
 TEST_F(UrdfInputTest, LongChainsOfFixedLinksAreWalkedWithoutRecursion) {
