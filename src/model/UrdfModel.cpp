@@ -13,6 +13,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <numbers>
@@ -503,6 +504,11 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     } else {
       l.positionMin = j->limits->lower;
       l.positionMax = j->limits->upper;
+      if (!(l.positionMin <= l.positionMax)) {
+        char range[96];
+        std::snprintf(range, sizeof range, "lower %g is above upper %g", l.positionMin, l.positionMax);
+        throw UrdfError(fileName + ": joint '" + excerpt(j->name) + "': <limit> " + range);
+      }
     }
     if (j->limits && j->limits->effort > 0) l.torqueLimit = j->limits->effort;
     if (j->limits && j->limits->velocity > 0) l.velocityLimit = j->limits->velocity;
@@ -531,7 +537,12 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     l.inertia = Matrix<3, 3>(R.transpose() * Ic * R);
   }
   const Transform tool = Transform(rigidInverse(F[static_cast<std::size_t>(n)]) * linkPose);
-  auto model = std::make_unique<ManipulatorModel>(robot->getName(), links, F[0], tool);
+  std::unique_ptr<ManipulatorModel> model;
+  try {
+    model = std::make_unique<ManipulatorModel>(robot->getName(), links, F[0], tool);
+  } catch (const std::invalid_argument& e) {  // whatever the model itself refuses, named by file
+    throw UrdfError(fileName + ": " + e.what());
+  }
   // Self-check: the DH chain must reproduce the URDF's poses at q = 0.
   ManipulatorData data(*model);
   const Transform& T = forwardKinematics(*model, data, JointVector(n));

@@ -380,6 +380,16 @@ TEST_F(UrdfInputTest, JointsMustNameDefinedLinksAndOneRoot) {
   EXPECT_EQ(message(f), f + ": links 'a' and 'c' both have no parent joint; a robot has one root link");
 }
 
+// Found by rp_urdf_fuzzer: limits the model refuses were thrown as a bare std::invalid_argument
+// without the file (the fuzzer, catching UrdfError only, aborted).
+TEST_F(UrdfInputTest, LimitsTheModelRefusesNameTheFileAndJoint) {
+  const std::string f = write("limits.urdf",
+                              "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/><joint name=\"j\" type=\"revolute\">"
+                              "<parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/>"
+                              "<limit lower=\"1\" upper=\"-1\" effort=\"1\" velocity=\"1\"/></joint></robot>");
+  EXPECT_EQ(message(f), f + ": joint 'j': <limit> lower 1 is above upper -1");
+}
+
 TEST_F(UrdfInputTest, LongChainsOfFixedLinksAreWalkedWithoutRecursion) {
   // Used to overflow the stack: one recursive call per fixed link (and one more per link when
   // urdfdom's model was freed).
