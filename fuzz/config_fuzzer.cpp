@@ -48,6 +48,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // The message always names the file (and the line when there is one).
     if (std::string(e.what()).rfind("fuzz.cfg:", 0) != 0) std::abort();
     if (e.line() < 0) std::abort();
+    // Words from the input are quoted as short excerpts only.
+    if (e.message().size() > 600) std::abort();
   }
   return 0;
 }

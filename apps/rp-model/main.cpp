@@ -5,11 +5,13 @@
 // COMMAND: fk | jacobian | gravity | rnea --qd .. --qdd .. | inertia | fd --qd .. --tau .. |
 //          ik --pose p1,...,p16 [--seed ..] | urdf
 // Options: --motor-inertia and --friction add those effects to inertia, rnea and fd.
-// Units: SI and radians. Matrices are JSON arrays of rows. Bad input: one line on stderr, exit 2.
+// Units: SI and radians. Matrices are JSON arrays of rows. Bad input: one line on stderr, exit 2
+// (values that are not finite numbers, a --pose that is not a rigid transform).
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <map>
@@ -40,6 +42,7 @@ std::vector<double> numbers(const std::string& option, const std::string& text) 
     if (item.empty() || end == item.c_str() || *end != '\0') {
       throw UsageError(option + ": '" + item + "' is not a number");
     }
+    if (!std::isfinite(x)) throw UsageError(option + ": '" + item + "' is not a finite number");
     v.push_back(x);
   }
   return v;
@@ -140,6 +143,8 @@ int run(int argc, char** argv) {
     Transform T;
     for (int r = 0; r < 4; ++r)
       for (int c = 0; c < 4; ++c) T(r, c) = p[static_cast<std::size_t>(4 * r + c)];
+    if (const std::string problem = rigidTransformError(T); !problem.empty())
+      throw UsageError("--pose is not a rigid transform: it " + problem);
     json solutions = json::array();
     if (const auto* puma = dynamic_cast<const Puma560Model*>(model.get())) {
       std::array<Puma560IkSolution, 8> all;

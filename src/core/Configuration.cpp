@@ -2,17 +2,19 @@
 #include "rp/core/Configuration.hpp"
 
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <climits>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 
 #include "rp/core/TypeDatabase.hpp"
 
@@ -39,15 +41,41 @@ bool parseNumber(const std::string& token, double& value) {
   return ec == std::errc() && ptr == end;
 }
 
+// Reads a regular file of at most ConfigLimits::kMaxFileBytes. Devices, FIFOs and sockets are
+// refused before they are opened (opening a FIFO blocks, /dev/zero never ends).
 std::string readTextFile(const std::string& fileName) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(fileName, ec)) throw ConfigError(fileName, 0, "cannot read the file: it is a directory");
-  std::ifstream in(fileName, std::ios::binary);
-  if (!in) throw ConfigError(fileName, 0, std::string("cannot read the file: ") + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ConfigError(fileName, 0, "cannot read the file: read error");
-  return text.str();
+  auto fail = [&](const std::string& why) { return ConfigError(fileName, 0, "cannot read the file: " + why); };
+  struct stat st {};
+  if (::stat(fileName.c_str(), &st) != 0) throw fail(std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) throw fail("it is a directory");
+  if (!S_ISREG(st.st_mode)) throw fail("it is not a regular file");
+  // O_NONBLOCK: should the path be replaced by a FIFO after stat(), open() does not wait.
+  const int fd = ::open(fileName.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) throw fail(std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  if (::fstat(fd, &st) != 0) throw fail(std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) throw fail("it is not a regular file");
+  const std::size_t cap = ConfigLimits::kMaxFileBytes;
+  auto tooLarge = [&] {
+    return fail("it is larger than " + std::to_string(cap) + " bytes (" + std::to_string(cap >> 20) + " MiB)");
+  };
+  if (st.st_size > static_cast<off_t>(cap)) throw tooLarge();
+  std::string text;
+  char buffer[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw fail(std::strerror(errno));
+    }
+    if (n == 0) break;
+    if (text.size() + static_cast<std::size_t>(n) > cap) throw tooLarge();  // grew after fstat()
+    text.append(buffer, static_cast<std::size_t>(n));
+  }
+  return text;
 }
 
 namespace {
@@ -64,7 +92,8 @@ bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' ||
 std::vector<Line> splitLines(const std::string& text, const std::string& fileName) {
   std::vector<Line> lines;
   int number = 1;
-  std::size_t start = 0;
+  // A UTF-8 byte-order mark (as some Windows editors write) is not part of the first line.
+  std::size_t start = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
   while (start <= text.size()) {
     std::size_t end = text.find('\n', start);
     if (end == std::string::npos) end = text.size();
@@ -105,6 +134,8 @@ std::vector<Line> splitLines(const std::string& text, const std::string& fileNam
   return lines;
 }
 
+std::string ex(const std::string& text) { return ConfigError::excerpt(text); }
+
 bool isIdentifier(const std::string& s, bool allowDash) {
   if (s.empty()) return false;
   if (!(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
@@ -124,6 +155,16 @@ std::string describeCount(const SettingSpec& spec) {
   return what;
 }
 
+// `MIN..MAX [unit]` for messages.
+std::string describeRange(const SettingSpec& spec) {
+  auto fmt = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.15g", v);
+    return std::string(buf);
+  };
+  return fmt(spec.minValue) + ".." + fmt(spec.maxValue) + (spec.unit.empty() ? "" : " [" + spec.unit + "]");
+}
+
 std::string resolvePath(const std::string& configFile, const std::string& path) {
   std::filesystem::path p(path);
   if (p.is_absolute()) return path;
@@ -138,18 +179,24 @@ void checkSetting(const SettingSpec& spec, const ConfigSetting& s, const std::st
   const int n = static_cast<int>(s.values.size());
   if (n < spec.minValues || n > spec.maxValues)
     throw ConfigError(file, s.line,
-                      "setting '" + s.name + "' needs " + describeCount(spec) + ", got " + std::to_string(n));
+                      "setting '" + ex(s.name) + "' needs " + describeCount(spec) + ", got " + std::to_string(n));
   for (const auto& v : s.values) {
     switch (spec.kind) {
       case SettingKind::Number: {
         double d;
         if (!parseNumber(v, d)) {
           std::string reason = "is not a number";
-          if (std::from_chars(v.data(), v.data() + v.size(), d).ec == std::errc() && !std::isfinite(d))
+          const char* b = v.data() + (!v.empty() && v[0] == '+' ? 1 : 0);
+          const auto r = std::from_chars(b, v.data() + v.size(), d);
+          if (r.ec == std::errc::result_out_of_range && r.ptr == v.data() + v.size())
+            reason = "is out of the range of numbers";
+          else if (r.ec == std::errc() && !std::isfinite(d))
             reason = "is not a finite number";
-          throw ConfigError(file, s.line, "setting '" + s.name + "': '" + v + "' " + reason);
+          throw ConfigError(file, s.line, "setting '" + ex(s.name) + "': '" + ex(v) + "' " + reason);
         }
-        if (!std::isfinite(d)) throw ConfigError(file, s.line, "setting '" + s.name + "': '" + v + "' is not a finite number");
+        if (!std::isfinite(d)) throw ConfigError(file, s.line, "setting '" + ex(s.name) + "': '" + ex(v) + "' is not a finite number");
+        if (d < spec.minValue || d > spec.maxValue)
+          throw ConfigError(file, s.line, "setting '" + ex(s.name) + "': '" + ex(v) + "' is outside " + describeRange(spec));
         break;
       }
       case SettingKind::Integer: {
@@ -157,14 +204,19 @@ void checkSetting(const SettingSpec& spec, const ConfigSetting& s, const std::st
         const char* b = v.data();
         if (!v.empty() && v[0] == '+') ++b;
         auto [ptr, ec] = std::from_chars(b, v.data() + v.size(), x);
-        if (ec != std::errc() || ptr != v.data() + v.size() || b == v.data() + v.size())
-          throw ConfigError(file, s.line, "setting '" + s.name + "': '" + v + "' is not an integer");
+        const bool whole = ptr == v.data() + v.size() && b != v.data() + v.size();
+        if (ec == std::errc::result_out_of_range && whole)
+          throw ConfigError(file, s.line, "setting '" + ex(s.name) + "': '" + ex(v) + "' is outside " + describeRange(spec));
+        if (ec != std::errc() || !whole)
+          throw ConfigError(file, s.line, "setting '" + ex(s.name) + "': '" + ex(v) + "' is not an integer");
+        if (static_cast<double>(x) < spec.minValue || static_cast<double>(x) > spec.maxValue)
+          throw ConfigError(file, s.line, "setting '" + ex(s.name) + "': '" + ex(v) + "' is outside " + describeRange(spec));
         break;
       }
       case SettingKind::Choice:
         if (std::find(spec.choices.begin(), spec.choices.end(), v) == spec.choices.end())
           throw ConfigError(file, s.line,
-                            "setting '" + s.name + "': '" + v + "' is not one of " + joinWords(spec.choices, ", "));
+                            "setting '" + ex(s.name) + "': '" + ex(v) + "' is not one of " + joinWords(spec.choices, ", "));
         break;
       case SettingKind::Word:
         break;
@@ -174,7 +226,17 @@ void checkSetting(const SettingSpec& spec, const ConfigSetting& s, const std::st
 
 }  // namespace internal
 
+using internal::ex;
+
 // ---- ConfigError -----------------------------------------------------------------------------
+
+std::string ConfigError::excerpt(const std::string& text) {
+  if (text.size() <= kExcerptBytes) return text;
+  std::size_t n = kExcerptBytes - 3;
+  // Do not cut a UTF-8 character: back up over continuation bytes (10xxxxxx).
+  while (n > 0 && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;
+  return text.substr(0, n) + "...";
+}
 
 ConfigError::ConfigError(const std::string& file, int line, const std::string& message)
     : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + message),
@@ -198,8 +260,19 @@ void SettingSchema::addNumbers(const std::string& name, int count, const std::st
   add(SettingSpec{name, SettingKind::Number, count, count, {}, unit, description});
 }
 
+void SettingSchema::addNumbers(const std::string& name, int count, const std::string& unit,
+                               const std::string& description, double minValue, double maxValue) {
+  add(SettingSpec{name, SettingKind::Number, count, count, {}, unit, description, minValue, maxValue});
+}
+
 void SettingSchema::addInteger(const std::string& name, const std::string& description) {
-  add(SettingSpec{name, SettingKind::Integer, 1, 1, {}, "", description});
+  addInteger(name, description, INT_MIN, INT_MAX);
+}
+
+void SettingSchema::addInteger(const std::string& name, const std::string& description, long long minValue,
+                               long long maxValue) {
+  add(SettingSpec{name, SettingKind::Integer, 1, 1, {}, "", description, static_cast<double>(minValue),
+                  static_cast<double>(maxValue)});
 }
 
 void SettingSchema::addWord(const std::string& name, const std::string& description) {
@@ -240,18 +313,18 @@ ParameterFile ParameterFile::parse(const std::string& text, const std::string& f
       throw ConfigError(fileName, line.number, "sections ('[...]') are not allowed in a control-program file");
     const std::string& name = line.words[0];
     if (!internal::isIdentifier(name, false))
-      throw ConfigError(fileName, line.number, "'" + name + "' is not a valid parameter name");
-    if (line.words.size() < 2) throw ConfigError(fileName, line.number, "'" + name + "' has no value");
+      throw ConfigError(fileName, line.number, "'" + ex(name) + "' is not a valid parameter name");
+    if (line.words.size() < 2) throw ConfigError(fileName, line.number, "'" + ex(name) + "' has no value");
     if (auto it = seen.find(name); it != seen.end())
       throw ConfigError(fileName, line.number,
-                        "'" + name + "' is given twice (first at line " + std::to_string(it->second) + ")");
+                        "'" + ex(name) + "' is given twice (first at line " + std::to_string(it->second) + ")");
     seen[name] = line.number;
     ConfigSetting entry{name, {line.words.begin() + 1, line.words.end()}, line.number};
     if (name != "log") {
       for (const auto& v : entry.values) {
         double d;
         if (!internal::parseNumber(v, d) || !std::isfinite(d))
-          throw ConfigError(fileName, line.number, "'" + name + "': '" + v + "' is not a number");
+          throw ConfigError(fileName, line.number, "'" + ex(name) + "': '" + ex(v) + "' is not a number");
       }
     }
     file.entries_.push_back(std::move(entry));
@@ -273,12 +346,12 @@ const ConfigSetting* ConfigSection::find(const std::string& name) const {
 
 std::vector<double> ConfigSection::getNumbers(const std::string& name) const {
   const ConfigSetting* s = find(name);
-  if (!s) throw ConfigError(fileName_, line_, "section [" + name_ + "] has no setting '" + name + "'");
+  if (!s) throw ConfigError(fileName_, line_, "section [" + ex(name_) + "] has no setting '" + ex(name) + "'");
   std::vector<double> out;
   for (const auto& v : s->values) {
     double d;
     if (!internal::parseNumber(v, d) || !std::isfinite(d))
-      throw errorAt(*s, "setting '" + name + "': '" + v + "' is not a number");
+      throw errorAt(*s, "setting '" + ex(name) + "': '" + ex(v) + "' is not a number");
     out.push_back(d);
   }
   return out;
@@ -286,8 +359,8 @@ std::vector<double> ConfigSection::getNumbers(const std::string& name) const {
 
 std::string ConfigSection::getWord(const std::string& name) const {
   const ConfigSetting* s = find(name);
-  if (!s) throw ConfigError(fileName_, line_, "section [" + name_ + "] has no setting '" + name + "'");
-  if (s->values.empty()) throw errorAt(*s, "setting '" + name + "' has no value");
+  if (!s) throw ConfigError(fileName_, line_, "section [" + ex(name_) + "] has no setting '" + ex(name) + "'");
+  if (s->values.empty()) throw errorAt(*s, "setting '" + ex(name) + "' has no value");
   return s->values[0];
 }
 
@@ -310,14 +383,14 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
 
   auto finishSection = [&] {
     if (current && current->className_.empty())
-      throw ConfigError(fileName, current->line_, "section [" + current->name_ + "] has no 'class' setting");
+      throw ConfigError(fileName, current->line_, "section [" + ex(current->name_) + "] has no 'class' setting");
   };
 
   for (auto& line : internal::splitLines(text, fileName)) {
     if (line.trimmed[0] == '[') {
       std::size_t close = line.trimmed.find(']');
       if (close == std::string::npos)
-        throw ConfigError(fileName, line.number, "section header '" + line.trimmed + "' is missing ']'");
+        throw ConfigError(fileName, line.number, "section header '" + ex(line.trimmed) + "' is missing ']'");
       std::string rest = line.trimmed.substr(close + 1);
       rest.erase(0, rest.find_first_not_of(" \t\r\f\v") == std::string::npos ? rest.size()
                                                                             : rest.find_first_not_of(" \t\r\f\v"));
@@ -326,16 +399,20 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
       name.erase(name.begin(), std::find_if(name.begin(), name.end(), notSpace));
       name.erase(std::find_if(name.rbegin(), name.rend(), notSpace).base(), name.end());
       if (!rest.empty())
-        throw ConfigError(fileName, line.number, "unexpected text '" + rest + "' after section header [" + name + "]");
+        throw ConfigError(fileName, line.number, "unexpected text '" + ex(rest) + "' after section header [" + ex(name) + "]");
       if (name.empty()) throw ConfigError(fileName, line.number, "empty section name '[]'");
       if (!internal::isIdentifier(name, true))
         throw ConfigError(fileName, line.number,
-                          "section name '" + name +
+                          "section name '" + ex(name) +
                               "' must start with a letter or '_' and contain only letters, digits, '_' and '-'");
       finishSection();
       if (auto it = sectionLines.find(name); it != sectionLines.end())
         throw ConfigError(fileName, line.number,
-                          "duplicate section [" + name + "] (first at line " + std::to_string(it->second) + ")");
+                          "duplicate section [" + ex(name) + "] (first at line " + std::to_string(it->second) + ")");
+      if (cfg.sections_.size() >= ConfigLimits::kMaxSections)
+        throw ConfigError(fileName, line.number,
+                          "too many sections: a file may configure at most " +
+                              std::to_string(ConfigLimits::kMaxSections) + " objects");
       sectionLines[name] = line.number;
       settingLines.clear();
       cfg.sections_.emplace_back();
@@ -353,18 +430,25 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
           throw ConfigError(fileName, line.number,
                             "setting 'plugin' needs 1 value (a shared library path), got " +
                                 std::to_string(setting.values.size()));
+        if (setting.values[0].size() > ConfigLimits::kMaxPathBytes)
+          throw ConfigError(fileName, line.number,
+                            "setting 'plugin': the path is longer than " +
+                                std::to_string(ConfigLimits::kMaxPathBytes) + " bytes");
+        if (cfg.plugins_.size() >= ConfigLimits::kMaxPlugins)
+          throw ConfigError(fileName, line.number,
+                            "too many 'plugin' lines (at most " + std::to_string(ConfigLimits::kMaxPlugins) + ")");
         setting.values[0] = internal::resolvePath(fileName, setting.values[0]);
         cfg.plugins_.push_back(std::move(setting));
         continue;
       }
       throw ConfigError(fileName, line.number,
-                        "setting '" + name + "' is outside a section (start one with a [name] line)");
+                        "setting '" + ex(name) + "' is outside a section (start one with a [name] line)");
     }
     if (!internal::isIdentifier(name, false))
-      throw ConfigError(fileName, line.number, "'" + name + "' is not a valid setting name");
+      throw ConfigError(fileName, line.number, "'" + ex(name) + "' is not a valid setting name");
     if (auto it = settingLines.find(name); it != settingLines.end())
       throw ConfigError(fileName, line.number,
-                        "setting '" + name + "' is given twice in [" + current->name_ + "] (first at line " +
+                        "setting '" + ex(name) + "' is given twice in [" + ex(current->name_) + "] (first at line " +
                             std::to_string(it->second) + ")");
     settingLines[name] = line.number;
     if (name == "class") {
@@ -380,6 +464,10 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
         throw ConfigError(fileName, line.number,
                           "setting 'qmotorConfig' needs 1 value (a file name), got " +
                               std::to_string(setting.values.size()));
+      if (setting.values[0].size() > ConfigLimits::kMaxPathBytes)
+        throw ConfigError(fileName, line.number,
+                          "setting 'qmotorConfig': the path is longer than " +
+                              std::to_string(ConfigLimits::kMaxPathBytes) + " bytes");
       if (options.readQMotorFiles) {
         const std::string path = internal::resolvePath(fileName, setting.values[0]);
         std::string text;
@@ -387,7 +475,7 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
           text = internal::readTextFile(path);
         } catch (const ConfigError& e) {
           throw ConfigError(fileName, line.number,
-                            "qmotorConfig file '" + setting.values[0] + "' " +
+                            "qmotorConfig file '" + ex(setting.values[0]) + "' " +
                                 (e.message().rfind("cannot read the file: ", 0) == 0
                                      ? "cannot be read: " + e.message().substr(22)
                                      : e.message()));
@@ -403,8 +491,10 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
     for (const auto& p : cfg.plugins_) {
       if (!dlopen(p.values[0].c_str(), RTLD_NOW | RTLD_GLOBAL)) {
         const char* err = dlerror();
-        throw ConfigError(fileName, p.line,
-                          "plugin '" + p.values[0] + "' cannot be loaded: " + (err ? err : "unknown error"));
+        // dlerror() repeats the path: quote only an excerpt of it there too.
+        std::string why = err ? err : "unknown error";
+        if (why.rfind(p.values[0], 0) == 0) why = ex(p.values[0]) + why.substr(p.values[0].size());
+        throw ConfigError(fileName, p.line, "plugin '" + ex(p.values[0]) + "' cannot be loaded: " + why);
       }
     }
   }
@@ -414,13 +504,13 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
       const TypeInfo* type = db.find(section.className_);
       if (!type)
         throw ConfigError(fileName, section.classLine_,
-                          "class '" + section.className_ + "' is not known (known: " + db.knownNames() + ")");
+                          "class '" + ex(section.className_) + "' is not known (known: " + db.knownNames() + ")");
       for (const auto& s : section.settings_) {
         if (s.name == "qmotorConfig") continue;
         const SettingSpec* spec = type->schema.find(s.name);
         if (!spec)
           throw ConfigError(fileName, s.line,
-                            "setting '" + s.name + "' is not known for class " + section.className_ +
+                            "setting '" + ex(s.name) + "' is not known for class " + section.className_ +
                                 " (known: " + type->schema.knownNames() + ")");
         internal::checkSetting(*spec, s, fileName);
       }

@@ -47,8 +47,9 @@ PhysicalObject::~PhysicalObject() { withdrawObject(); }  // first thing for a pl
 
 void PhysicalObject::declareSettings(SettingSchema& schema) {
   RoboticObject::declareSettings(schema);
-  schema.addNumbers("position", 3, "mm", "x y z");
-  schema.addNumbers("orientation", 3, "deg", "roll pitch yaw");
+  // Within 1 km of the world origin; angles within one turn either way.
+  schema.addNumbers("position", 3, "mm", "x y z", -1e6, 1e6);
+  schema.addNumbers("orientation", 3, "deg", "roll pitch yaw", -360, 360);
   schema.addChoice("simulationMode", {"on", "off"}, "simulate instead of using the hardware");
   schema.addChoice("display", {"off", "solid", "wireframe"}, "how the Scene Viewer shows the object");
 }

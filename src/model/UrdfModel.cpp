@@ -1,16 +1,25 @@
 // Loading manipulator models from URDF (rp/model/UrdfModel.hpp).
 #include "rp/model/UrdfModel.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <tinyxml.h>
+#include <unistd.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
-#include <fstream>
-#include <functional>
+#include <cstdio>
+#include <cstring>
+#include <map>
 #include <numbers>
-#include <sstream>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "rp/model/Kinematics.hpp"
@@ -20,6 +29,9 @@ namespace rp {
 namespace {
 
 using V3 = Eigen::Vector3d;
+
+constexpr std::size_t kMaxUrdfBytes = std::size_t{64} << 20;  // largest URDF file read
+constexpr std::size_t kMaxUrdfDepth = 100;                     // deepest element nesting accepted
 
 Transform toTransform(const urdf::Pose& p) {
   Transform t = Transform::unit();
@@ -65,17 +77,277 @@ V3 anyPerpendicular(const V3& z) {
   return (trial - trial.dot(z) * z).normalized();
 }
 
+// At most this much of a name is quoted in a message.
+std::string excerpt(const std::string& text) {
+  constexpr std::size_t kMax = 40;
+  if (text.size() <= kMax) return text;
+  std::size_t n = kMax - 3;
+  while (n > 0 && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;  // whole UTF-8 characters
+  return text.substr(0, n) + "...";
+}
+
+// The file's text: a regular file of at most kMaxUrdfBytes (a device such as /dev/zero or a FIFO
+// is refused before it is opened).
+std::string readUrdfFile(const std::string& fileName) {
+  struct stat st {};
+  if (::stat(fileName.c_str(), &st) != 0) throw UrdfError(fileName + ": cannot read the file");
+  if (!S_ISREG(st.st_mode)) throw UrdfError(fileName + ": cannot read the file: it is not a regular file");
+  const int fd = ::open(fileName.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) throw UrdfError(fileName + ": cannot read the file");
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  const std::string tooLarge = fileName + ": the file is larger than " + std::to_string(kMaxUrdfBytes >> 20) + " MiB";
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
+    throw UrdfError(fileName + ": cannot read the file: it is not a regular file");
+  if (st.st_size > static_cast<off_t>(kMaxUrdfBytes)) throw UrdfError(tooLarge);
+  std::string text;
+  char buffer[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw UrdfError(fileName + ": cannot read the file: " + std::strerror(errno));
+    if (n == 0) break;
+    if (text.size() + static_cast<std::size_t>(n) > kMaxUrdfBytes) throw UrdfError(tooLarge);
+    text.append(buffer, static_cast<std::size_t>(n));
+  }
+  return text;
+}
+
+// Refuses XML whose elements nest deeper than kMaxUrdfDepth: the XML parser recurses once per
+// level, so a deep enough document would overflow the stack. Counts start and end tags, skipping
+// comments, CDATA, processing instructions, declarations and quoted attribute values.
+void checkNesting(const std::string& text, const std::string& fileName) {
+  std::size_t depth = 0;
+  std::size_t i = 0;
+  auto skipPast = [&](const char* end) {
+    const std::size_t at = text.find(end, i);
+    i = at == std::string::npos ? text.size() : at + std::strlen(end);
+  };
+  while ((i = text.find('<', i)) != std::string::npos) {
+    if (text.compare(i, 4, "<!--") == 0) {
+      skipPast("-->");
+    } else if (text.compare(i, 9, "<![CDATA[") == 0) {
+      skipPast("]]>");
+    } else if (text.compare(i, 2, "<?") == 0) {
+      skipPast("?>");
+    } else if (text.compare(i, 2, "<!") == 0 || text.compare(i, 2, "</") == 0) {
+      if (text[i + 1] == '/' && depth > 0) --depth;
+      skipPast(">");
+    } else {
+      // A start tag: find its '>' outside quotes; "/>" closes it at once.
+      char quote = 0;
+      std::size_t j = i + 1;
+      for (; j < text.size(); ++j) {
+        const char c = text[j];
+        if (quote) {
+          if (c == quote) quote = 0;
+        } else if (c == '"' || c == '\'') {
+          quote = c;
+        } else if (c == '>') {
+          break;
+        }
+      }
+      if (j >= text.size()) return;  // unterminated: the parser reports it
+      if (text[j - 1] != '/' && ++depth > kMaxUrdfDepth)
+        throw UrdfError(fileName + ": elements nest deeper than " + std::to_string(kMaxUrdfDepth) + " levels");
+      i = j + 1;
+    }
+  }
+}
+
+// Parses an attribute as a finite number; false if it is missing or not one.
+bool finiteAttribute(const TiXmlElement* e, const char* name, double& value) {
+  const char* text = e ? e->Attribute(name) : nullptr;
+  if (!text) return false;
+  std::string t(text);
+  const auto b = t.find_first_not_of(" \t\r\n"), last = t.find_last_not_of(" \t\r\n");
+  if (b == std::string::npos) return false;
+  t = t.substr(b, last - b + 1);
+  const char* begin = t.data() + (t[0] == '+' ? 1 : 0);
+  const auto [ptr, ec] = std::from_chars(begin, t.data() + t.size(), value);
+  return ec == std::errc() && ptr == t.data() + t.size() && std::isfinite(value);
+}
+
+// An optional attribute of three numbers ("x y z"): absent, or three finite numbers.
+bool finiteTriple(const TiXmlElement* e, const char* name) {
+  const char* text = e ? e->Attribute(name) : nullptr;
+  if (!text) return true;
+  const std::string t(text);
+  int count = 0;
+  std::size_t i = 0;
+  while (true) {
+    i = t.find_first_not_of(" \t\r\n", i);
+    if (i == std::string::npos) break;
+    const std::size_t end = std::min(t.find_first_of(" \t\r\n", i), t.size());
+    const char* begin = t.data() + i + (t[i] == '+' ? 1 : 0);
+    double v = 0;
+    const auto [ptr, ec] = std::from_chars(begin, t.data() + end, v);
+    if (ec != std::errc() || ptr != t.data() + end || !std::isfinite(v)) return false;
+    ++count;
+    i = end;
+  }
+  return count == 3;
+}
+
+// Checks every link's <inertial> in the XML itself: urdfdom drops an inertial it cannot parse
+// (mass="nan", a missing inertia attribute) with a message on stderr and loads a massless link.
+void checkInertials(const TiXmlElement* robot, const std::string& fileName) {
+  for (const TiXmlElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link")) {
+    const TiXmlElement* inertial = link->FirstChildElement("inertial");
+    if (!inertial) continue;
+    const char* nameAttribute = link->Attribute("name");
+    const std::string where = fileName + ": link '" + excerpt(nameAttribute ? nameAttribute : "") + "': <inertial> ";
+    auto quoted = [](const TiXmlElement* e, const char* name) {
+      const char* v = e ? e->Attribute(name) : nullptr;
+      if (!v) return std::string("missing");
+      std::string q(1, '\'');  // appended piece by piece: GCC 12 warns (-Wrestrict) about "'" + s
+      q += excerpt(v);
+      q += '\'';
+      return q;
+    };
+    const TiXmlElement* origin = inertial->FirstChildElement("origin");
+    for (const char* name : {"xyz", "rpy"})
+      if (!finiteTriple(origin, name))
+        throw UrdfError(where + "origin " + name + " " + quoted(origin, name) + " is not three finite numbers");
+    const TiXmlElement* mass = inertial->FirstChildElement("mass");
+    double m = 0;
+    if (!finiteAttribute(mass, "value", m))
+      throw UrdfError(where + "mass value is not a finite number (" + quoted(mass, "value") + ")");
+    if (m < 0) throw UrdfError(where + "mass " + quoted(mass, "value") + " is negative");
+    const TiXmlElement* inertia = inertial->FirstChildElement("inertia");
+    for (const char* name : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}) {
+      double v = 0;
+      if (!finiteAttribute(inertia, name, v))
+        throw UrdfError(where + "inertia " + name + " is not a finite number (" + quoted(inertia, name) + ")");
+    }
+  }
+}
+
+constexpr const char* kLoop = ": a kinematic loop; a manipulator's links must form a tree";
+
+// Checks in the XML that the joints link the links into one tree, before urdfdom builds it:
+// urdfdom accepts a kinematic loop (and walking it never ends), and when it fails half-way
+// (a second root, a joint naming an unknown link) it leaks a loop's links and frees a long chain
+// with one recursive call per link.
+void checkJointGraph(const TiXmlElement* robot, const std::string& fileName) {
+  std::vector<std::string> links;  // in file order
+  std::unordered_set<std::string> defined;
+  for (const TiXmlElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link")) {
+    const char* name = link->Attribute("name");
+    if (name && defined.insert(name).second) links.emplace_back(name);
+  }
+  std::unordered_map<std::string, std::pair<std::string, std::string>> parentOf;  // link -> (parent link, joint)
+  for (const TiXmlElement* joint = robot->FirstChildElement("joint"); joint; joint = joint->NextSiblingElement("joint")) {
+    const char* nameAttribute = joint->Attribute("name");
+    const std::string name = nameAttribute ? nameAttribute : "";
+    const TiXmlElement* parentElement = joint->FirstChildElement("parent");
+    const TiXmlElement* childElement = joint->FirstChildElement("child");
+    const char* parent = parentElement ? parentElement->Attribute("link") : nullptr;
+    const char* child = childElement ? childElement->Attribute("link") : nullptr;
+    const std::string where = fileName + ": joint '" + excerpt(name) + "'";
+    if (!parent || !*parent) throw UrdfError(where + " has no parent link");
+    if (!child || !*child) throw UrdfError(where + " has no child link");
+    for (const char* link : {parent, child})
+      if (!defined.count(link)) throw UrdfError(where + ": there is no link '" + excerpt(link) + "'");
+    const auto [it, added] = parentOf.emplace(child, std::make_pair(std::string(parent), name));
+    if (!added)
+      throw UrdfError(fileName + ": link '" + excerpt(child) + "' is the child of two joints ('" +
+                      excerpt(it->second.second) + "' and '" + excerpt(name) + "')" + kLoop);
+  }
+  std::vector<const std::string*> roots;
+  for (const std::string& link : links)
+    if (!parentOf.count(link)) roots.push_back(&link);
+  if (roots.empty() && !links.empty())
+    throw UrdfError(fileName + ": there is no root link (every link is the child of a joint)" + kLoop);
+  if (roots.size() > 1)
+    throw UrdfError(fileName + ": links '" + excerpt(*roots[0]) + "' and '" + excerpt(*roots[1]) +
+                    "' both have no parent joint; a robot has one root link");
+  // Every link must reach the root through its parents; a walk that comes back to a link of its
+  // own is a loop. Links found to reach the root are remembered, so each link is walked once.
+  std::unordered_set<std::string> reachesRoot;
+  if (!roots.empty()) reachesRoot.insert(*roots[0]);
+  std::unordered_set<std::string> walk;
+  for (const std::string& start : links) {
+    walk.clear();
+    std::string link = start;
+    while (!reachesRoot.count(link)) {
+      if (!walk.insert(link).second)
+        throw UrdfError(fileName + ": link '" + excerpt(start) + "' cannot be reached from the root link '" +
+                        excerpt(*roots[0]) + "'" + kLoop);
+      link = parentOf.at(link).first;
+    }
+    reachesRoot.insert(walk.begin(), walk.end());
+  }
+}
+
+// The checks that need the XML itself (see checkInertials() and checkJointGraph()).
+void checkDocument(const std::string& text, const std::string& fileName) {
+  TiXmlDocument doc;
+  doc.Parse(text.c_str());
+  if (doc.Error()) return;  // urdfdom reports malformed XML
+  const TiXmlElement* robot = doc.FirstChildElement("robot");
+  if (!robot) return;  // and a missing <robot>
+  checkInertials(robot, fileName);
+  checkJointGraph(robot, fileName);
+}
+
+// The same for the model urdfdom built (a second line of defence: urdfdom might read the XML
+// differently): one tree under the root.
+void checkTree(const urdf::ModelInterface& robot, const urdf::Link& root, const std::string& fileName) {
+  std::map<std::string, std::string> parentJoint;  // child link -> joint
+  for (const auto& [name, joint] : robot.joints_) {
+    if (!joint) continue;
+    const auto [it, added] = parentJoint.emplace(joint->child_link_name, name);
+    if (!added)
+      throw UrdfError(fileName + ": link '" + excerpt(joint->child_link_name) + "' is the child of two joints ('" +
+                      excerpt(it->second) + "' and '" + excerpt(name) + "')" + kLoop);
+  }
+  std::unordered_set<const urdf::Link*> seen{&root};
+  std::vector<const urdf::Link*> todo{&root};
+  while (!todo.empty()) {
+    const urdf::Link* link = todo.back();
+    todo.pop_back();
+    for (const urdf::LinkSharedPtr& child : link->child_links)
+      if (child && seen.insert(child.get()).second) todo.push_back(child.get());
+  }
+  for (const auto& [name, link] : robot.links_)
+    if (link && !seen.count(link.get()))
+      throw UrdfError(fileName + ": link '" + excerpt(name) + "' cannot be reached from the root link '" +
+                      excerpt(root.name) + "'" + kLoop);
+}
+
+// Whether every number of a pose is finite.
+bool finite(const urdf::Pose& p) {
+  return std::isfinite(p.position.x) && std::isfinite(p.position.y) && std::isfinite(p.position.z) &&
+         std::isfinite(p.rotation.x) && std::isfinite(p.rotation.y) && std::isfinite(p.rotation.z) &&
+         std::isfinite(p.rotation.w);
+}
+
+// urdfdom links children with shared pointers: a long chain would be freed by one recursive
+// destructor call per link (a stack overflow for 100,000 links) and a loop would never be freed.
+// Dropping those pointers first leaves each link to be freed alone by the model's own maps.
+struct UnlinkOnExit {
+  urdf::ModelInterface& robot;
+  ~UnlinkOnExit() {
+    for (auto& [name, link] : robot.links_)
+      if (link) link->child_links.clear();
+  }
+};
+
 }  // namespace
 
 std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options) {
-  std::ifstream in(fileName);
-  if (!in) throw UrdfError(fileName + ": cannot read the file");
-  std::stringstream text;
-  text << in.rdbuf();
-  const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text.str());
+  const std::string text = readUrdfFile(fileName);
+  checkNesting(text, fileName);
+  checkDocument(text, fileName);
+  const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text);
   if (!robot) throw UrdfError(fileName + ": not a valid URDF document (malformed XML or URDF structure)");
+  const UnlinkOnExit unlink{*robot};
   const urdf::LinkConstSharedPtr root = robot->getRoot();
   if (!root) throw UrdfError(fileName + ": the robot has no root link");
+  checkTree(*robot, *root, fileName);
 
   // The chain of joints from the root to the tip.
   urdf::LinkConstSharedPtr tip;
@@ -107,33 +379,45 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
   std::vector<urdf::JointConstSharedPtr> movable;
   std::vector<Body> bodies;
   Transform linkPose = Transform::unit();
-  std::vector<std::string> chainLinks;
-  for (const urdf::JointConstSharedPtr& j : chain) chainLinks.push_back(j->child_link_name);
-  // A link's inertia and that of everything fixed to it off the chain (e.g. a camera).
-  std::function<void(const urdf::LinkConstSharedPtr&, const Transform&)> addInertial =
-      [&](const urdf::LinkConstSharedPtr& link, const Transform& pose) {
-        if (bodies.empty()) return;  // links before the first joint belong to the base
-        if (link->inertial) {
-          const Transform in = Transform(pose * toTransform(link->inertial->origin));
-          const Eigen::Matrix3d R = in.topLeftCorner<3, 3>();
-          Eigen::Matrix3d I;
-          const urdf::Inertial& i = *link->inertial;
-          I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
-          bodies.back().add(i.mass, in.topRightCorner<3, 1>(), R * I * R.transpose());
-        }
-        for (const urdf::JointSharedPtr& c : link->child_joints) {
-          if (c->type != urdf::Joint::FIXED) continue;
-          if (std::find(chainLinks.begin(), chainLinks.end(), c->child_link_name) != chainLinks.end()) continue;
-          addInertial(robot->getLink(c->child_link_name), Transform(pose * toTransform(c->parent_to_joint_origin_transform)));
-        }
-      };
+  std::unordered_set<std::string> chainLinks;
+  for (const urdf::JointConstSharedPtr& j : chain) chainLinks.insert(j->child_link_name);
+  // A link's inertia and that of everything fixed to it off the chain (e.g. a camera), walked
+  // with an explicit stack: a chain of many fixed links must not recurse once per link.
+  std::vector<std::pair<urdf::LinkConstSharedPtr, Transform>> pending;
+  auto addInertial = [&](const urdf::LinkConstSharedPtr& start, const Transform& startPose) {
+    if (bodies.empty()) return;  // links before the first joint belong to the base
+    pending.clear();
+    pending.emplace_back(start, startPose);
+    while (!pending.empty()) {
+      const urdf::LinkConstSharedPtr link = pending.back().first;
+      const Transform pose = pending.back().second;
+      pending.pop_back();
+      if (link->inertial) {
+        const Transform in = Transform(pose * toTransform(link->inertial->origin));
+        const Eigen::Matrix3d R = in.topLeftCorner<3, 3>();
+        Eigen::Matrix3d I;
+        const urdf::Inertial& i = *link->inertial;
+        I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
+        bodies.back().add(i.mass, in.topRightCorner<3, 1>(), R * I * R.transpose());
+      }
+      for (const urdf::JointSharedPtr& c : link->child_joints) {
+        if (c->type != urdf::Joint::FIXED) continue;
+        if (chainLinks.count(c->child_link_name)) continue;
+        pending.emplace_back(robot->getLink(c->child_link_name),
+                             Transform(pose * toTransform(c->parent_to_joint_origin_transform)));
+      }
+    }
+  };
   for (const urdf::JointConstSharedPtr& j : chain) {
+    if (!finite(j->parent_to_joint_origin_transform))
+      throw UrdfError(fileName + ": joint '" + excerpt(j->name) + "' has an origin that is not finite");
     const Transform jointFrame = Transform(linkPose * toTransform(j->parent_to_joint_origin_transform));
     switch (j->type) {
       case urdf::Joint::REVOLUTE:
       case urdf::Joint::CONTINUOUS:
       case urdf::Joint::PRISMATIC: {
         V3 axis(j->axis.x, j->axis.y, j->axis.z);
+        if (!axis.allFinite()) throw UrdfError(fileName + ": joint '" + excerpt(j->name) + "' has an axis that is not finite");
         if (axis.norm() < 1e-12) throw UrdfError(fileName + ": joint '" + j->name + "' has a zero axis");
         axis = jointFrame.topLeftCorner<3, 3>() * axis.normalized();
         axes.push_back({V3(jointFrame.topRightCorner<3, 1>()), axis});
@@ -220,6 +504,11 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     } else {
       l.positionMin = j->limits->lower;
       l.positionMax = j->limits->upper;
+      if (!(l.positionMin <= l.positionMax)) {
+        char range[96];
+        std::snprintf(range, sizeof range, "lower %g is above upper %g", l.positionMin, l.positionMax);
+        throw UrdfError(fileName + ": joint '" + excerpt(j->name) + "': <limit> " + range);
+      }
     }
     if (j->limits && j->limits->effort > 0) l.torqueLimit = j->limits->effort;
     if (j->limits && j->limits->velocity > 0) l.velocityLimit = j->limits->velocity;
@@ -248,7 +537,12 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     l.inertia = Matrix<3, 3>(R.transpose() * Ic * R);
   }
   const Transform tool = Transform(rigidInverse(F[static_cast<std::size_t>(n)]) * linkPose);
-  auto model = std::make_unique<ManipulatorModel>(robot->getName(), links, F[0], tool);
+  std::unique_ptr<ManipulatorModel> model;
+  try {
+    model = std::make_unique<ManipulatorModel>(robot->getName(), links, F[0], tool);
+  } catch (const std::invalid_argument& e) {  // whatever the model itself refuses, named by file
+    throw UrdfError(fileName + ": " + e.what());
+  }
   // Self-check: the DH chain must reproduce the URDF's poses at q = 0.
   ManipulatorData data(*model);
   const Transform& T = forwardKinematics(*model, data, JointVector(n));

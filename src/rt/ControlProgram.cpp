@@ -601,17 +601,59 @@ std::vector<ParameterInfo> ControlProgram::getParameters() const {
   return out;
 }
 
+namespace internal {
+bool parseNumber(const std::string& token, double& value);  // Configuration.cpp: whole token, finite
+}  // namespace internal
+
+namespace {
+
+// Ranges of the control-program settings a qmotorConfig file may give (docs/core.md).
+constexpr double kMaxQMotorRate = 20000;             // Hz
+constexpr long long kMaxQMotorLogEvery = 1000000;    // cycles
+constexpr long long kMaxQMotorLogBuffer = 1000000;   // samples
+
+// The one value of setting `e` as a number in (low, high] (or [low, high] when `openLow` is
+// false); a ConfigError at the setting's line naming it otherwise.
+double qmotorNumber(const ParameterFile& file, const ConfigSetting& e, double low, double high, bool openLow,
+                    const char* unit) {
+  if (e.values.size() != 1)
+    throw file.errorAt(e, "'" + e.name + "' needs 1 value, got " + std::to_string(e.values.size()));
+  const std::string& v = e.values[0];
+  double d = 0;
+  const bool ok = internal::parseNumber(v, d) && std::isfinite(d) && (openLow ? d > low : d >= low) && d <= high;
+  if (!ok) {
+    char range[96];
+    std::snprintf(range, sizeof range, "%s%g, %g] %s", openLow ? "(" : "[", low, high, unit);
+    throw file.errorAt(e, "'" + e.name + "' must be a number in " + range + ", got '" + ConfigError::excerpt(v) + "'");
+  }
+  return d;
+}
+
+// The one value of setting `e` as a whole number in [low, high]; a ConfigError otherwise.
+long long qmotorInteger(const ParameterFile& file, const ConfigSetting& e, long long low, long long high) {
+  if (e.values.size() != 1)
+    throw file.errorAt(e, "'" + e.name + "' needs 1 value, got " + std::to_string(e.values.size()));
+  const std::string& v = e.values[0];
+  double d = 0;
+  // Compared as doubles before any conversion: a huge value never goes through a narrowing cast.
+  const bool ok = internal::parseNumber(v, d) && std::isfinite(d) && d == std::floor(d) &&
+                  d >= static_cast<double>(low) && d <= static_cast<double>(high);
+  if (!ok)
+    throw file.errorAt(e, "'" + e.name + "' must be an integer in " + std::to_string(low) + ".." + std::to_string(high) +
+                              ", got '" + ConfigError::excerpt(v) + "'");
+  return static_cast<long long>(d);
+}
+
+}  // namespace
+
 void ControlProgram::applyQMotorConfig(const ParameterFile& file) {
-  auto number = [&](const ConfigSetting& e) {
-    if (e.values.size() != 1) throw file.errorAt(e, "'" + e.name + "' needs 1 value, got " + std::to_string(e.values.size()));
-    return std::stod(e.values[0]);
-  };
   for (const auto& e : file.entries()) {
     try {
-      if (e.name == "rate") setRate(number(e));
-      else if (e.name == "priority") setPriority(static_cast<int>(number(e)));
-      else if (e.name == "logEvery") setLogEvery(static_cast<unsigned>(std::max(0.0, number(e))));
-      else if (e.name == "logBufferSize") setLogBufferSize(static_cast<std::size_t>(std::max(0.0, number(e))));
+      if (e.name == "rate") setRate(qmotorNumber(file, e, 0, kMaxQMotorRate, true, "Hz"));
+      else if (e.name == "priority") setPriority(static_cast<int>(qmotorInteger(file, e, 1, 99)));
+      else if (e.name == "logEvery") setLogEvery(static_cast<unsigned>(qmotorInteger(file, e, 1, kMaxQMotorLogEvery)));
+      else if (e.name == "logBufferSize")
+        setLogBufferSize(static_cast<std::size_t>(qmotorInteger(file, e, 2, kMaxQMotorLogBuffer)));
       else if (e.name == "log") {
         impl_->checkNotRunning("applyQMotorConfig");
         for (auto& v : impl_->logVars) v.selected = false;
@@ -620,8 +662,8 @@ void ControlProgram::applyQMotorConfig(const ParameterFile& file) {
           if (it == impl_->logVars.end()) {
             std::string known;
             for (auto& v : impl_->logVars) known += (known.empty() ? "" : ", ") + v.info.name;
-            throw file.errorAt(e, "'log': '" + w + "' is not a log variable of " + impl_->name + " (known: " +
-                                      (known.empty() ? "none" : known) + ")");
+            throw file.errorAt(e, "'log': '" + ConfigError::excerpt(w) + "' is not a log variable of " + impl_->name +
+                                      " (known: " + (known.empty() ? "none" : known) + ")");
           }
           it->selected = true;
         }
@@ -631,10 +673,16 @@ void ControlProgram::applyQMotorConfig(const ParameterFile& file) {
         if (!known) {
           std::string names = "rate, priority, logEvery, logBufferSize, log";
           for (auto& p : impl_->params) names += ", " + p->info.name;
-          throw file.errorAt(e, "'" + e.name + "' is not a parameter of " + impl_->name + " (known: " + names + ")");
+          throw file.errorAt(e, "'" + ConfigError::excerpt(e.name) + "' is not a parameter of " + impl_->name +
+                                    " (known: " + names + ")");
         }
         std::vector<double> values;
-        for (const auto& v : e.values) values.push_back(std::stod(v));
+        for (const auto& v : e.values) {
+          double d = 0;
+          if (!internal::parseNumber(v, d) || !std::isfinite(d))
+            throw file.errorAt(e, "'" + e.name + "': '" + ConfigError::excerpt(v) + "' is not a finite number");
+          values.push_back(d);
+        }
         Impl::Param& p = impl_->findParam(e.name);
         if (values.size() == 1 && p.info.size > 1) values.assign(p.info.size, values[0]);
         setParameter(e.name, values);

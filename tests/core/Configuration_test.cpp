@@ -2,6 +2,7 @@
 #include "rp/core/Configuration.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "TestClasses.hpp"
 #include "rp/core/TypeDatabase.hpp"
@@ -162,7 +163,78 @@ INSTANTIATE_TEST_SUITE_P(
                   "rp.cfg:1: plugin '/nonexistent/librp_nothing.so' cannot be loaded: /nonexistent/librp_nothing.so: "
                   "cannot open shared object file: No such file or directory"},
         Malformed{std::string("[a]\nclass Test\0Arm\n", 19), "rp.cfg:2: the file is not a text file (byte 0x00 in column 11)"},
-        Malformed{"[a]\nclass TestArm\nport \x01\n", "rp.cfg:3: the file is not a text file (byte 0x01 in column 6)"}));
+        Malformed{"[a]\nclass TestArm\nport \x01\n", "rp.cfg:3: the file is not a text file (byte 0x01 in column 6)"},
+        // Ranges (issue 19): a huge position used to fail later with neither the setting nor the line.
+        Malformed{"[a]\nclass TestArm\nposition 1e308 1e308 1e308\n",
+                  "rp.cfg:3: setting 'position': '1e308' is outside -1000000..1000000 [mm]"},
+        Malformed{"[a]\nclass TestArm\nposition 0 0 -1000000.5\n",
+                  "rp.cfg:3: setting 'position': '-1000000.5' is outside -1000000..1000000 [mm]"},
+        Malformed{"[a]\nclass TestArm\norientation 0 361 0\n",
+                  "rp.cfg:3: setting 'orientation': '361' is outside -360..360 [deg]"},
+        Malformed{"[a]\nclass TestArm\nposition 1e400 0 0\n",
+                  "rp.cfg:3: setting 'position': '1e400' is out of the range of numbers"},
+        Malformed{"[a]\nclass TestArm\ncount 2147483648\n",
+                  "rp.cfg:3: setting 'count': '2147483648' is outside -2147483648..2147483647"},
+        Malformed{"[a]\nclass TestArm\ncount -99999999999999999999999\n",
+                  "rp.cfg:3: setting 'count': '-99999999999999999999999' is outside -2147483648..2147483647"},
+        // Quoted text is cut to an excerpt.
+        Malformed{"[a]\nclass TestArm\nposition 1 2 " + std::string(100, '7') + "x\n",
+                  "rp.cfg:3: setting 'position': '" + std::string(37, '7') + "...' is not a number"}));
+
+// A UTF-8 byte-order mark (Windows editors) is not part of the first line of either kind of file.
+TEST(Configuration, ByteOrderMarkIsSkipped) {
+  Configuration cfg = Configuration::parse("\xEF\xBB\xBF[a]\nclass TestArm\n");
+  ASSERT_EQ(cfg.sections().size(), 1u);
+  EXPECT_EQ(cfg.sections()[0].name(), "a");
+  EXPECT_EQ(cfg.sections()[0].line(), 1);
+  ParameterFile p = ParameterFile::parse("\xEF\xBB\xBFkp 1 2\n", "leader.cfg");
+  ASSERT_EQ(p.entries().size(), 1u);
+  EXPECT_EQ(p.entries()[0].name, "kp");
+  // Only at the very start: elsewhere the bytes are text as before.
+  EXPECT_THROW(Configuration::parse("[a]\nclass TestArm\n\xEF\xBB\xBFport x\n"), ConfigError);
+}
+
+// A 10 MB token is quoted as a short excerpt, in both kinds of file.
+TEST(Configuration, HugeTokensAreQuotedShort) {
+  const std::string huge(10 << 20, 'x');
+  auto message = [](auto&& parse) -> std::string {
+    try {
+      parse();
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  const std::string excerpt = "'" + std::string(37, 'x') + "...'";
+  for (const std::string& text : {"[a]\nclass TestArm\nposition 1 2 " + huge + "\n", "[" + huge + "\n",
+                                  "[a] " + huge + "\n", "[a]\nclass " + huge + "\n", huge + " 1\n",
+                                  "[a]\nclass TestArm\n" + huge + " 1\n"}) {
+    const std::string m = message([&] { Configuration::parse(text); });
+    EXPECT_LT(m.size(), 300u) << m.substr(0, 300);
+    EXPECT_EQ(m.rfind("rp.cfg:", 0), 0u) << m.substr(0, 300);
+  }
+  EXPECT_EQ(message([&] { ParameterFile::parse("kp " + huge + "\n", "leader.cfg"); }),
+            "leader.cfg:1: 'kp': " + excerpt + " is not a number");
+  // Cut at a character boundary: no half of a two-byte UTF-8 character.
+  const std::string umlauts = std::string(36, 'a') + "\xC3\xA4\xC3\xA4\xC3\xA4";
+  EXPECT_EQ(ConfigError::excerpt(umlauts), std::string(36, 'a') + "...");
+  EXPECT_EQ(ConfigError::excerpt("short"), "short");
+  EXPECT_EQ(ConfigError::excerpt(std::string(40, 'a')), std::string(40, 'a'));
+}
+
+// How many objects a file may create is bounded.
+TEST(Configuration, SectionCountIsBounded) {
+  std::string text;
+  for (std::size_t i = 0; i < ConfigLimits::kMaxSections; ++i) text += "[o" + std::to_string(i) + "]\nclass TestArm\n";
+  EXPECT_EQ(Configuration::parse(text).sections().size(), ConfigLimits::kMaxSections);
+  text += "[last]\nclass TestArm\n";
+  try {
+    Configuration::parse(text);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "rp.cfg:2001: too many sections: a file may configure at most 1000 objects");
+  }
+}
 
 // Messages whose text depends on the registered classes or on files.
 TEST(Configuration, UnknownClassListsTheKnownOnes) {
@@ -196,6 +268,43 @@ TEST(Configuration, UnreadableFiles) {
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()), dir.string() + ": cannot read the file: it is a directory");
   }
+}
+
+// Only regular files are read, up to a size cap: /dev/zero used to be read until std::bad_alloc
+// aborted the process, and a FIFO blocked it.
+TEST(Configuration, OnlyRegularFilesOfBoundedSize) {
+  auto message = [](const std::string& file) -> std::string {
+    try {
+      Configuration::read(file);
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(message("/dev/zero"), "/dev/zero: cannot read the file: it is not a regular file");
+  EXPECT_EQ(message("/dev/null"), "/dev/null: cannot read the file: it is not a regular file");
+  auto dir = test::scratchDirectory("special");
+  const std::string fifo = (dir / "fifo.cfg").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(message(fifo), fifo + ": cannot read the file: it is not a regular file");
+  // The largest file accepted, and one byte more.
+  std::string text = "[a]\nclass TestArm\n";
+  text += std::string(ConfigLimits::kMaxFileBytes - text.size() - 1, '#') + "\n";
+  test::writeFile(dir / "big.cfg", text);
+  EXPECT_EQ(message((dir / "big.cfg").string()), "no error");
+  test::writeFile(dir / "big.cfg", text + "\n");
+  EXPECT_EQ(message((dir / "big.cfg").string()),
+            (dir / "big.cfg").string() + ": cannot read the file: it is larger than 1048576 bytes (1 MiB)");
+  // The same for a qmotorConfig file, reported at the rp.cfg line that names it.
+  for (const std::string& q : {std::string("/dev/zero"), fifo, (dir / "big.cfg").string()}) {
+    test::writeFile(dir / "rp.cfg", "[leader]\nclass TestArm\nqmotorConfig " + q + "\n");
+    const std::string m = message((dir / "rp.cfg").string());
+    EXPECT_EQ(m.rfind((dir / "rp.cfg").string() + ":3: qmotorConfig file '", 0), 0u) << m;
+    EXPECT_NE(m.find("' cannot be read: it is "), std::string::npos) << m;
+  }
+  test::writeFile(dir / "rp.cfg", "[leader]\nclass TestArm\nqmotorConfig " + std::string(5000, 'p') + "\n");
+  EXPECT_EQ(message((dir / "rp.cfg").string()),
+            (dir / "rp.cfg").string() + ":3: setting 'qmotorConfig': the path is longer than 4095 bytes");
 }
 
 TEST(Configuration, QMotorFileErrorsNameThatFile) {

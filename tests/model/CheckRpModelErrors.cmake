@@ -1,23 +1,45 @@
-# Each bad invocation of rp-model must print exactly one line on stderr and exit with status 2.
+# Each bad invocation of rp-model must print exactly one line on stderr and exit with status 2
+# (and within the test's timeout: a kinematic loop used to hang it). DATA: tests/model/data.
+# Each case is one string of space-separated arguments (a CMake list of ';'-separated words would
+# be flattened into one long list, one word per run).
 set(cases
-  "--robot;nosuchrobot;fk;--q;0,0,0,0,0,0"
-  "--robot;puma560;fk;--q;0,0,0"
-  "--robot;puma560;fk;--q;0,0,x,0,0,0"
-  "--robot;puma560;fk"
-  "--robot;puma560;dance;--q;0,0,0,0,0,0"
-  "--robot;puma560;ik;--pose;1,0,0,5,0,1,0,0,0,0,1,0,0,0,0,1"
-  "--robot;puma560;ik;--pose;1,2,3"
-  "--robot;missing.urdf;fk;--q;0"
-  "--robot;puma560;--tip;link3;fk;--q;0,0,0,0,0,0"
-  "fk;--q;0,0,0,0,0,0")
+  "--robot nosuchrobot fk --q 0,0,0,0,0,0"
+  "--robot puma560 fk --q 0,0,0"
+  "--robot puma560 fk --q 0,0,x,0,0,0"
+  "--robot puma560 fk"
+  "--robot puma560 dance --q 0,0,0,0,0,0"
+  "--robot puma560 ik --pose 1,0,0,5,0,1,0,0,0,0,1,0,0,0,0,1"
+  "--robot puma560 ik --pose 1,2,3"
+  "--robot missing.urdf fk --q 0"
+  "--robot puma560 --tip link3 fk --q 0,0,0,0,0,0"
+  "fk --q 0,0,0,0,0,0"
+  # Issue 20: values that are not finite numbers, poses that are not rigid transforms.
+  "--robot puma560 fk --q 0,0,nan,0,0,0"
+  "--robot puma560 fk --q 0,0,0,inf,0,0"
+  "--robot puma560 fk --q 0,0,0,0,1e999,0"
+  "--robot puma560 rnea --q 0,0,0,0,0,0 --qd 0,0,0,0,0,0 --qdd 0,-nan,0,0,0,0"
+  "--robot wam7 ik --pose 2,0,0,0.3,0,2,0,0,0,0,2,0.5,0,0,0,1"
+  "--robot wam7 ik --pose 0,0,0,0.3,0,0,0,0,0,0,0,0.5,0,0,0,1"
+  "--robot puma560 ik --pose 2,0,0,0.3,0,2,0,0,0,0,2,0.5,0,0,0,1"
+  "--robot wam7 ik --pose 1,0,0,0.3,0,1,0,0,0,0,-1,0.5,0,0,0,1"
+  "--robot wam7 ik --pose 1,0,0,0.3,0,1,0,0,0,0,1,0.5,0,0,1,1"
+  "--robot wam7 ik --pose 1,0,0,nan,0,1,0,0,0,0,1,0.5,0,0,0,1"
+  # Issue 19: URDF files with a kinematic loop (used to hang) or a NaN mass (used to load).
+  "--robot ${DATA}/kinematic_loop.urdf fk --q 0,0"
+  "--robot ${DATA}/nan_mass.urdf gravity --q 0")
+set(count 0)
 foreach(args IN LISTS cases)
-  string(REPLACE ";" " " shown "${args}")
+  set(shown "${args}")
   separate_arguments(argv UNIX_COMMAND "${shown}")
-  execute_process(COMMAND ${PROGRAM} ${argv} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  execute_process(COMMAND ${PROGRAM} ${argv} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 60)
   string(STRIP "${err}" err)
   string(FIND "${err}" "\n" newline)
   if(NOT rc EQUAL 2 OR NOT newline EQUAL -1 OR NOT err MATCHES "^rp-model: ")
     message(FATAL_ERROR "rp-model ${shown}: status ${rc}, stderr '${err}'")
   endif()
   message("rp-model ${shown} -> ${err}")
+  math(EXPR count "${count} + 1")
 endforeach()
+if(NOT count EQUAL 22)
+  message(FATAL_ERROR "${count} cases ran, expected 22")
+endif()

@@ -2,8 +2,10 @@
 // vectors within the limits), each solved from a random seed: solve rate and accuracy.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <random>
+#include <stdexcept>
 
 #include "rp/model/InverseKinematics.hpp"
 #include "rp/model/Kinematics.hpp"
@@ -56,6 +58,55 @@ TEST(NumericIk, Wam7SolvesReachablePoses) {
   RecordProperty("solve_rate", std::to_string(rate));
   std::cout << "WAM 7 full-pose solve rate over " << kPoses << " poses: " << rate << std::endl;
   EXPECT_GE(rate, 0.995);
+}
+
+// Issue 19/20: a target that is not a rigid transform is refused; a rotation block of zeros used
+// to be reported as Solved.
+TEST(NumericIk, TargetsThatAreNotRigidTransformsAreRefused) {
+  const WAM7Model wam;
+  ManipulatorData data(wam);
+  JointVector q(7);
+  JointVector goal(7);
+  goal << 0.3, 0.4, 0.2, 1.1, 0.3, -0.5, 0.7;
+  ASSERT_TRUE(wam.isWithinLimits(goal));
+  const Transform reachable = forwardKinematics(wam, data, goal);
+  auto message = [&](const Transform& target) -> std::string {
+    try {
+      (void)inverseKinematics(wam, data, target, wam.getHomePosition(), q);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  Transform zeros = reachable;
+  zeros.topLeftCorner<3, 3>().setZero();
+  EXPECT_EQ(message(zeros),
+            "inverseKinematics: the target pose has a rotation block that is not orthonormal (R^T R differs from I by 1; "
+            "at most 0.001)");
+  Transform twice = reachable;
+  twice.topLeftCorner<3, 3>() = 2 * Eigen::Matrix3d::Identity();
+  EXPECT_EQ(message(twice),
+            "inverseKinematics: the target pose has a rotation block that is not orthonormal (R^T R differs from I by 3; "
+            "at most 0.001)");
+  Transform mirrored = reachable;
+  mirrored.block<3, 1>(0, 2) *= -1;
+  EXPECT_EQ(message(mirrored),
+            "inverseKinematics: the target pose has a rotation block that is a reflection (determinant -1), not a rotation");
+  Transform lastRow = reachable;
+  lastRow(3, 2) = 1;
+  EXPECT_EQ(message(lastRow), "inverseKinematics: the target pose has a last row other than 0 0 0 1");
+  Transform notFinite = reachable;
+  notFinite(1, 3) = std::nan("");
+  EXPECT_EQ(message(notFinite), "inverseKinematics: the target pose has an element that is not a finite number");
+  EXPECT_EQ(message(reachable), "accepted");
+  // A rotation typed with four decimals is close enough, and solved to its nearest rotation.
+  Transform typed = reachable;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) typed(r, c) = std::round(reachable(r, c) * 1e4) / 1e4;
+  EXPECT_EQ(rigidTransformError(typed), "");
+  EXPECT_EQ(inverseKinematics(wam, data, typed, wam.getHomePosition(), q), IkStatus::Solved);
+  EXPECT_NE(rigidTransformError(zeros), "");
+  EXPECT_EQ(rigidTransformError(Transform::unit()), "");
 }
 
 TEST(NumericIk, Wam4PositionOnlyAndPuma) {

@@ -11,7 +11,11 @@
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -293,6 +297,155 @@ TEST(UrdfModel, BadFilesGiveClearErrors) {
   dynamics.requireDynamics = true;
   EXPECT_NE(message(kData + "/no_inertia.urdf", dynamics).find("link 'b' has no inertial data"), std::string::npos);
   EXPECT_EQ(message(kData + "/no_inertia.urdf"), "no error") << "kinematics only is fine";
+}
+
+// Issue 19: bad URDF files never hang or crash the process.
+class UrdfInputTest : public ::testing::Test {
+ protected:
+  std::string write(const std::string& name, const std::string& text) {
+    const std::string file = (dir_ / name).string();
+    std::ofstream(file) << text;
+    return file;
+  }
+  static std::string message(const std::string& file, const UrdfOptions& o = UrdfOptions()) {
+    try {
+      loadUrdf(file, o);
+    } catch (const UrdfError& e) {
+      return e.what();
+    }
+    return "no error";
+  }
+  static std::string joint(const std::string& name, const std::string& type, const std::string& parent,
+                           const std::string& child) {
+    return "<joint name=\"" + name + "\" type=\"" + type + "\"><parent link=\"" + parent + "\"/><child link=\"" + child +
+           "\"/><origin xyz=\"0 0 0.001\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+           "velocity=\"1\"/></joint>\n";
+  }
+  static std::string inertial(const std::string& mass, const std::string& ixx = "1", const std::string& origin = "") {
+    return "<inertial>" + origin + "<mass value=\"" + mass + "\"/><inertia ixx=\"" + ixx +
+           "\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>";
+  }
+  // A revolute joint a -> l0, then `n` fixed links l0 -> l1 -> ... -> ln, each 1 g.
+  std::string fixedChain(int n) {
+    std::string text = "<robot name=\"long\"><link name=\"a\"/>\n";
+    for (int i = 0; i <= n; ++i) text += "<link name=\"l" + std::to_string(i) + "\">" + inertial("0.001") + "</link>\n";
+    text += joint("j", "revolute", "a", "l0");
+    for (int i = 1; i <= n; ++i)
+      text += joint("f" + std::to_string(i), "fixed", "l" + std::to_string(i - 1), "l" + std::to_string(i));
+    return write("long.urdf", text + "</robot>\n");
+  }
+  std::filesystem::path dir_ = [] {
+    auto d = std::filesystem::temp_directory_path() / ("rp_urdf_input_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  ~UrdfInputTest() override { std::filesystem::remove_all(dir_); }
+};
+
+TEST_F(UrdfInputTest, KinematicLoopsAreRefused) {
+  // Used to hang: the walk from the root to the tip went round the loop for ever.
+  EXPECT_EQ(message(kData + "/kinematic_loop.urdf"),
+            kData + "/kinematic_loop.urdf: link 'b' is the child of two joints ('j1' and 'j3'): a kinematic loop; "
+                    "a manipulator's links must form a tree");
+  // A loop away from the root: each link has one parent, but the loop hangs off nothing.
+  const std::string island =
+      write("island.urdf", "<robot name=\"island\"><link name=\"r\"/><link name=\"x\"/><link name=\"y\"/>" +
+                               joint("jx", "revolute", "y", "x") + joint("jy", "revolute", "x", "y") + "</robot>");
+  UrdfOptions tipX;
+  tipX.tip = "x";
+  EXPECT_EQ(message(island, tipX), island + ": link 'x' cannot be reached from the root link 'r': a kinematic loop; "
+                                            "a manipulator's links must form a tree");
+  // Found by rp_urdf_fuzzer: a link that is its own parent next to a joint urdfdom then refused
+  // (its parent element has no link attribute); urdfdom leaked the looped link.
+  const std::string self = write("self.urdf", "<robot name=\"self\"><link name=\"a\"/><link name=\"b\"/>" +
+                                                  joint("j1", "revolute", "a", "b") + joint("j2", "revolute", "b", "b") +
+                                                  "<joint name=\"j3\" type=\"fixed\"><parent lnk=\"b\"/><child link=\"a\"/></joint>"
+                                                  "</robot>");
+  EXPECT_EQ(message(self), self + ": link 'b' is the child of two joints ('j1' and 'j2'): a kinematic loop; "
+                                  "a manipulator's links must form a tree");
+  const std::string noRoot = write("noroot.urdf", "<robot name=\"n\"><link name=\"a\"/>" +
+                                                      joint("j", "revolute", "a", "a") + "</robot>");
+  EXPECT_EQ(message(noRoot), noRoot + ": there is no root link (every link is the child of a joint): a kinematic "
+                                      "loop; a manipulator's links must form a tree");
+}
+
+// What urdfdom would refuse only after building part of the tree is refused before it.
+TEST_F(UrdfInputTest, JointsMustNameDefinedLinksAndOneRoot) {
+  const std::string base = "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/>";
+  std::string f = write("j.urdf", base + joint("j", "revolute", "a", "c") + "</robot>");
+  EXPECT_EQ(message(f), f + ": joint 'j': there is no link 'c'");
+  f = write("j.urdf", base + "<joint name=\"j\" type=\"fixed\"><child link=\"b\"/></joint></robot>");
+  EXPECT_EQ(message(f), f + ": joint 'j' has no parent link");
+  f = write("j.urdf", base + "<link name=\"c\"/>" + joint("j", "revolute", "a", "b") + "</robot>");
+  EXPECT_EQ(message(f), f + ": links 'a' and 'c' both have no parent joint; a robot has one root link");
+}
+
+// Found by rp_urdf_fuzzer: limits the model refuses were thrown as a bare std::invalid_argument
+// without the file (the fuzzer, catching UrdfError only, aborted).
+TEST_F(UrdfInputTest, LimitsTheModelRefusesNameTheFileAndJoint) {
+  const std::string f = write("limits.urdf",
+                              "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/><joint name=\"j\" type=\"revolute\">"
+                              "<parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/>"
+                              "<limit lower=\"1\" upper=\"-1\" effort=\"1\" velocity=\"1\"/></joint></robot>");
+  EXPECT_EQ(message(f), f + ": joint 'j': <limit> lower 1 is above upper -1");
+}
+
+TEST_F(UrdfInputTest, LongChainsOfFixedLinksAreWalkedWithoutRecursion) {
+  // Used to overflow the stack: one recursive call per fixed link (and one more per link when
+  // urdfdom's model was freed).
+  const int n = 100000;
+  const std::string file = fixedChain(n);
+  std::unique_ptr<ManipulatorModel> model = loadUrdf(file);
+  ASSERT_EQ(model->getNumberOfJoints(), 1);
+  EXPECT_NEAR(model->getLink(0).mass, 0.001 * (n + 1), 1e-9);
+  // The same chain to its last link: every fixed joint on the chain itself.
+  UrdfOptions tip;
+  tip.tip = "l" + std::to_string(n);
+  model = loadUrdf(file, tip);
+  ASSERT_EQ(model->getNumberOfJoints(), 1);
+  EXPECT_NEAR(model->getLink(0).mass, 0.001 * (n + 1), 1e-9);
+  ManipulatorData data(*model);
+  EXPECT_NEAR(forwardKinematics(*model, data, JointVector(1))(2, 3), 0.001 * (n + 1), 1e-6);
+}
+
+TEST_F(UrdfInputTest, NonFiniteInertialsAreRefusedWithTheLinkName) {
+  // urdfdom drops an inertial it cannot parse (with a message of its own) and loads the link
+  // without mass: the arm used to load with exit 0.
+  EXPECT_EQ(message(kData + "/nan_mass.urdf"),
+            kData + "/nan_mass.urdf: link 'b': <inertial> mass value is not a finite number ('nan')");
+  auto arm = [&](const std::string& inertialXml) {
+    return write("arm.urdf", "<robot name=\"arm\"><link name=\"base\"/><link name=\"upper\">" + inertialXml +
+                                 "</link>" + joint("j", "revolute", "base", "upper") + "</robot>");
+  };
+  std::string f = arm(inertial("inf"));
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> mass value is not a finite number ('inf')");
+  f = arm(inertial("1e999"));
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> mass value is not a finite number ('1e999')");
+  f = arm(inertial("-2"));
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> mass '-2' is negative");
+  f = arm(inertial("2", "nan"));
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> inertia ixx is not a finite number ('nan')");
+  f = arm("<inertial><mass value=\"2\"/></inertial>");
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> inertia ixx is not a finite number (missing)");
+  f = arm(inertial("2", "1", "<origin xyz=\"0 nan 0\"/>"));
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> origin xyz '0 nan 0' is not three finite numbers");
+  f = arm(inertial("2", "1", "<origin xyz=\"0 0.1 0\" rpy=\"0 0 1\"/>"));
+  EXPECT_EQ(message(f), "no error");
+  EXPECT_NEAR(loadUrdf(f)->getLink(0).mass, 2.0, 1e-12);
+}
+
+TEST_F(UrdfInputTest, SpecialDeepAndHugeFilesAreRefused) {
+  EXPECT_EQ(message("/dev/zero"), "/dev/zero: cannot read the file: it is not a regular file");
+  const std::string fifo = (dir_ / "arm.urdf").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(message(fifo), fifo + ": cannot read the file: it is not a regular file");  // without blocking
+  // The XML parser recurses once per nesting level.
+  std::string deep = "<robot name=\"deep\">";
+  for (int i = 0; i < 200000; ++i) deep += "<a>";
+  const std::string f = write("deep.urdf", deep);
+  EXPECT_EQ(message(f), f + ": elements nest deeper than 100 levels");
+  const std::string big = write("big.urdf", "<robot name=\"big\">" + std::string(std::size_t{65} << 20, ' ') + "</robot>");
+  EXPECT_EQ(message(big), big + ": the file is larger than 64 MiB");
 }
 
 }  // namespace

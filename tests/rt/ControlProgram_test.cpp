@@ -351,7 +351,7 @@ TEST(ControlProgram, QMotorConfigFile) {
   EXPECT_EQ(message("kp 1 2\n"), "leader.cfg:1: ControlProgram leader: parameter 'kp' needs 3 values, got 2");
   EXPECT_EQ(message("rate 1 2\n"), "leader.cfg:1: 'rate' needs 1 value, got 2");
   EXPECT_EQ(message("log q tau\n"), "leader.cfg:1: 'log': 'tau' is not a log variable of leader (known: x, q)");
-  EXPECT_EQ(message("rate -5\n"), "leader.cfg:1: ControlProgram::setRate: the rate must be positive, got -5.000000");
+  EXPECT_EQ(message("rate -5\n"), "leader.cfg:1: 'rate' must be a number in (0, 20000] Hz, got '-5'");
   EXPECT_EQ(message("kp 7\n"), "no error");  // one value for every element
   EXPECT_EQ(r.kp(2), 7.0);
 
@@ -365,6 +365,50 @@ TEST(ControlProgram, QMotorConfigFile) {
   EXPECT_EQ(copy.kp(2), 7.0);
   EXPECT_EQ(copy.getRate(), 500.0);
   EXPECT_EQ(copy.getLogEvery(), 5u);
+}
+
+// Every size and count a control-program file gives is bounded and checked as a whole number
+// before any conversion; each refusal names the file, the line and the setting (issue 19).
+TEST(ControlProgram, QMotorConfigValuesAreBounded) {
+  Recorder r("leader");
+  auto message = [&](const std::string& text) {
+    try {
+      r.applyQMotorConfig(ParameterFile::parse(text, "leader.cfg"));
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // The size product of this one wrapped and overflowed the log buffer in the servo thread.
+  EXPECT_EQ(message("gain 1\nlogBufferSize 498560650640798720\n"),
+            "leader.cfg:2: 'logBufferSize' must be an integer in 2..1000000, got '498560650640798720'");
+  EXPECT_EQ(message("logBufferSize 1e9\n"), "leader.cfg:1: 'logBufferSize' must be an integer in 2..1000000, got '1e9'");
+  EXPECT_EQ(message("logBufferSize 1\n"), "leader.cfg:1: 'logBufferSize' must be an integer in 2..1000000, got '1'");
+  EXPECT_EQ(message("logBufferSize 100.5\n"),
+            "leader.cfg:1: 'logBufferSize' must be an integer in 2..1000000, got '100.5'");
+  EXPECT_EQ(message("rate 1e9\n"), "leader.cfg:1: 'rate' must be a number in (0, 20000] Hz, got '1e9'");
+  EXPECT_EQ(message("rate 0\n"), "leader.cfg:1: 'rate' must be a number in (0, 20000] Hz, got '0'");
+  EXPECT_EQ(message("logEvery 4294967297\n"),
+            "leader.cfg:1: 'logEvery' must be an integer in 1..1000000, got '4294967297'");
+  EXPECT_EQ(message("logEvery 0\n"), "leader.cfg:1: 'logEvery' must be an integer in 1..1000000, got '0'");
+  EXPECT_EQ(message("logEvery 2.5\n"), "leader.cfg:1: 'logEvery' must be an integer in 1..1000000, got '2.5'");
+  EXPECT_EQ(message("priority 1.5\n"), "leader.cfg:1: 'priority' must be an integer in 1..99, got '1.5'");
+  EXPECT_EQ(message("priority 100\n"), "leader.cfg:1: 'priority' must be an integer in 1..99, got '100'");
+  EXPECT_EQ(r.getLogEvery(), 1u) << "nothing of a refused line is applied";
+  // The largest values accepted.
+  EXPECT_EQ(message("rate 20000\nlogEvery 1000000\nlogBufferSize 1000000\npriority 99\n"), "no error");
+  EXPECT_EQ(r.getRate(), 20000.0);
+  EXPECT_EQ(r.getLogEvery(), 1000000u);
+  EXPECT_EQ(r.getPriority(), 99);
+  EXPECT_EQ(message("rate 1e-3\nlogEvery 1e3\nlogBufferSize +2\npriority 1\n"), "no error");
+  EXPECT_EQ(r.getRate(), 1e-3);
+  EXPECT_EQ(r.getLogEvery(), 1000u);
+  // A huge word is quoted as a short excerpt only.
+  const std::string huge(10 << 20, 'q');
+  const std::string m = message("log " + huge + "\n");
+  EXPECT_LT(m.size(), 200u) << m.substr(0, 200);
+  EXPECT_EQ(m.rfind("leader.cfg:1: 'log': 'qqqq", 0), 0u) << m.substr(0, 200);
+  EXPECT_NE(m.find("...' is not a log variable of leader"), std::string::npos) << m.substr(0, 200);
 }
 
 // An object with a control loop asks for a system shutdown from inside its cycle; the request

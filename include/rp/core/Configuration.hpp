@@ -8,6 +8,7 @@
 /// API (`PhysicalObject::setTransform()`) uses metres and radians.
 
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -30,6 +31,13 @@ class ConfigError : public std::runtime_error {
   int line() const noexcept { return line_; }
   /// The message without the `FILE:LINE: ` prefix.
   const std::string& message() const noexcept { return message_; }
+  /// A short excerpt of text from a file for a message: `text` itself when it has at most
+  /// kExcerptBytes bytes, else its first bytes (cut at a UTF-8 character boundary) followed by
+  /// `...`, so that a huge token is never quoted whole.
+  /// @param[in] text  the text to quote
+  static std::string excerpt(const std::string& text);
+  /// Longest text excerpt() returns unshortened [bytes].
+  static constexpr std::size_t kExcerptBytes = 40;
 
  private:
   std::string file_;
@@ -54,6 +62,18 @@ struct SettingSpec {
   std::vector<std::string> choices;  ///< allowed words when kind is Choice
   std::string unit;                  ///< unit of the values, e.g. `mm`, `deg` (may be empty)
   std::string description;           ///< one line for help texts and error messages
+  /// Smallest value allowed (Number and Integer); Integer settings default to the range of `int`.
+  double minValue = std::numeric_limits<double>::lowest();
+  /// Largest value allowed (Number and Integer).
+  double maxValue = std::numeric_limits<double>::max();
+};
+
+/// Limits on what a configuration file may hold (a file beyond them is refused with FILE:LINE).
+struct ConfigLimits {
+  static constexpr std::size_t kMaxFileBytes = 1u << 20;  ///< largest rp.cfg or qmotorConfig file [bytes]
+  static constexpr std::size_t kMaxSections = 1000;       ///< most `[name]` sections (objects) in rp.cfg
+  static constexpr std::size_t kMaxPlugins = 100;         ///< most `plugin` lines in rp.cfg
+  static constexpr std::size_t kMaxPathBytes = 4095;      ///< longest `plugin` or `qmotorConfig` path [bytes]
 };
 
 /// The settings a class accepts; each class adds its own to its base class's in a static
@@ -66,10 +86,25 @@ class SettingSchema {
   /// @param[in] unit         unit of the values
   /// @param[in] description  meaning of the values, e.g. `x y z`
   void addNumbers(const std::string& name, int count, const std::string& unit, const std::string& description);
-  /// Declares a setting of one integer.
+  /// Declares a setting of `count` numbers, each within [minValue, maxValue].
+  /// @param[in] name         setting name
+  /// @param[in] count        number of values
+  /// @param[in] unit         unit of the values
+  /// @param[in] description  meaning of the values, e.g. `x y z`
+  /// @param[in] minValue     smallest value allowed
+  /// @param[in] maxValue     largest value allowed
+  void addNumbers(const std::string& name, int count, const std::string& unit, const std::string& description,
+                  double minValue, double maxValue);
+  /// Declares a setting of one integer within the range of `int`.
   /// @param[in] name         setting name
   /// @param[in] description  meaning of the value
   void addInteger(const std::string& name, const std::string& description);
+  /// Declares a setting of one integer within [minValue, maxValue].
+  /// @param[in] name         setting name
+  /// @param[in] description  meaning of the value
+  /// @param[in] minValue     smallest value allowed
+  /// @param[in] maxValue     largest value allowed
+  void addInteger(const std::string& name, const std::string& description, long long minValue, long long maxValue);
   /// Declares a setting of one word (for example a device path such as `/dev/ser1`).
   /// @param[in] name         setting name
   /// @param[in] description  meaning of the value
@@ -107,7 +142,8 @@ class ParameterFile {
  public:
   /// Reads and checks the syntax of a parameter file.
   /// @param[in] fileName  path of the file
-  /// @throws ConfigError  if it cannot be read, is binary, or a line is malformed
+  /// @throws ConfigError  if it cannot be read, is not a regular file, is larger than
+  ///         ConfigLimits::kMaxFileBytes, is binary, or a line is malformed
   static ParameterFile read(const std::string& fileName);
   /// Parses text as a parameter file named `fileName` (for messages).
   /// @param[in] text      file contents
@@ -189,7 +225,8 @@ class Configuration {
 
   /// An empty configuration (no objects configured).
   Configuration() = default;
-  /// Reads, parses and checks a configuration file.
+  /// Reads, parses and checks a configuration file (a regular file of at most
+  /// ConfigLimits::kMaxFileBytes; a leading UTF-8 byte-order mark is skipped).
   /// @param[in] fileName  path of rp.cfg
   /// @param[in] options   what to check
   /// @throws ConfigError  with FILE:LINE for any problem

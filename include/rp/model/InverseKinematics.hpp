@@ -3,6 +3,7 @@
 /// Numeric inverse kinematics for any serial chain.
 
 #include <cstdint>
+#include <string>
 
 #include "rp/model/ManipulatorData.hpp"
 
@@ -33,6 +34,20 @@ struct IkOptions {
   int stallIterations = 12;
 };
 
+/// Largest deviation accepted by rigidTransformError(): of \f$R^T R\f$ from the identity (each
+/// element), enough for a rotation typed with three or four decimals.
+constexpr double kRigidTransformTolerance = 1e-3;
+
+/// Checks that `pose` is a rigid transform: every element finite, the last row exactly
+/// `0 0 0 1`, and the rotation block a proper rotation (\f$R^T R = I\f$ within `tolerance` for
+/// each element, \f$\det R > 0\f$).
+/// @param[in] pose       the 4 x 4 matrix to check
+/// @param[in] tolerance  largest deviation of \f$R^T R\f$ from the identity accepted
+/// @return an empty string if it is one, else what is wrong (e.g. `its rotation block is not
+///         orthonormal (R^T R differs from I by 3)`), to follow a description of the pose
+/// Real-time safe: only when it returns an empty string.
+std::string rigidTransformError(const Transform& pose, double tolerance = kRigidTransformTolerance);
+
 /// Solves \f$FK(q) = T\f$ by damped least squares (Levenberg-Marquardt) on the geometric
 /// Jacobian, keeping every joint inside its limits, starting from `seed` and then from random
 /// configurations within the limits (until `maxAttempts` or the `timeBudget` is spent).
@@ -49,7 +64,9 @@ struct IkOptions {
 /// @param[out] q        the solution (n x 1) [rad] (the best attempt if not solved)
 /// @param[in]  options  tolerances and budget
 /// @return Solved or NotConverged
-/// @throws std::invalid_argument if `seed` does not have one value per joint
+/// @throws std::invalid_argument if `seed` does not have one value per joint, or if `target` is
+///         not a rigid transform (see rigidTransformError(); a rotation block of zeros or 2 I
+///         used to be "solved")
 /// Real-time safe: yes (no allocation), but its run time depends on the pose (bound it with
 /// `timeBudget`).
 IkStatus inverseKinematics(const ManipulatorModel& model, ManipulatorData& data, const Transform& target,
