@@ -352,8 +352,8 @@ const std::string& ControlProgram::getProgramName() const { return impl_->name; 
 
 void ControlProgram::setRate(double hz) {
   impl_->checkNotRunning("setRate");
-  if (!(hz > 0) || !std::isfinite(hz))
-    throw std::invalid_argument("ControlProgram::setRate: the rate must be positive, got " + std::to_string(hz));
+  if (!(hz > 0) || !(hz <= kMaxRate))
+    throw std::invalid_argument("ControlProgram::setRate: the rate must be in (0, 20000] Hz, got " + std::to_string(hz));
   impl_->rate = hz;
 }
 double ControlProgram::getRate() const { return impl_->rate; }
@@ -412,6 +412,12 @@ void ControlProgram::start() {
         d.logSources.push_back(v.data + i);
       }
     }
+    // The ring holds logBufferSize rows of (time + columns) doubles: at most 1 GiB.
+    constexpr std::size_t kMaxRingDoubles = (std::size_t{1} << 30) / sizeof(double);
+    if (!columns.empty() && d.logBufferSize > kMaxRingDoubles / (columns.size() + 1))
+      throw std::invalid_argument("ControlProgram " + d.name + ": a log buffer of " + std::to_string(d.logBufferSize) +
+                                  " samples of " + std::to_string(columns.size()) +
+                                  " columns needs more than 1 GiB; set a smaller logBufferSize");
     if (!columns.empty()) d.channel = std::make_shared<LogWriter::Channel>(d.name, std::move(columns), d.logBufferSize);
   }
   d.writer = writer;
@@ -523,7 +529,8 @@ unsigned ControlProgram::getLogEvery() const { return impl_->logEvery; }
 
 void ControlProgram::setLogBufferSize(std::size_t samples) {
   impl_->checkNotRunning("setLogBufferSize");
-  if (samples < 2) throw std::invalid_argument("ControlProgram::setLogBufferSize: at least 2 samples");
+  if (samples < 2 || samples > kMaxLogBufferSize)
+    throw std::invalid_argument("ControlProgram::setLogBufferSize: 2 .. 1000000 samples, got " + std::to_string(samples));
   impl_->logBufferSize = samples;
 }
 
@@ -608,9 +615,9 @@ bool parseNumber(const std::string& token, double& value);  // Configuration.cpp
 namespace {
 
 // Ranges of the control-program settings a qmotorConfig file may give (docs/core.md).
-constexpr double kMaxQMotorRate = 20000;             // Hz
+constexpr double kMaxQMotorRate = ControlProgram::kMaxRate;  // Hz
 constexpr long long kMaxQMotorLogEvery = 1000000;    // cycles
-constexpr long long kMaxQMotorLogBuffer = 1000000;   // samples
+constexpr auto kMaxQMotorLogBuffer = static_cast<long long>(ControlProgram::kMaxLogBufferSize);  // samples
 
 // The one value of setting `e` as a number in (low, high] (or [low, high] when `openLow` is
 // false); a ConfigError at the setting's line naming it otherwise.

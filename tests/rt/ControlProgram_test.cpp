@@ -77,6 +77,12 @@ TEST(ControlProgram, Defaults) {
   EXPECT_EQ(r.getLogEvery(), 1u);
   EXPECT_FALSE(r.isRunning());
   EXPECT_THROW(r.setRate(0), std::invalid_argument);
+  EXPECT_THROW(r.setRate(20001), std::invalid_argument);  // every cycle would overrun
+  EXPECT_THROW(r.setRate(std::nan("")), std::invalid_argument);
+  EXPECT_THROW(r.setLogBufferSize(1), std::invalid_argument);
+  // 498560650640798720 samples from a qmotorConfig wrapped the ring's size and overflowed the heap.
+  EXPECT_THROW(r.setLogBufferSize(498560650640798720ULL), std::invalid_argument);
+  EXPECT_THROW(r.setLogBufferSize(ControlProgram::kMaxLogBufferSize + 1), std::invalid_argument);
   EXPECT_THROW(r.setPriority(100), std::invalid_argument);
   EXPECT_THROW(r.registerLogVariable("x", r.x), std::invalid_argument);
   EXPECT_THROW(r.registerLogVariable("a.b", r.x), std::invalid_argument);

@@ -91,9 +91,15 @@ class ControlProgram {
   /// @name Timing (set before start())
   /// @{
 
+  /// Highest loop rate setRate() accepts [Hz].
+  static constexpr double kMaxRate = 20000;
+  /// Largest log ring buffer setLogBufferSize() accepts [samples].
+  static constexpr std::size_t kMaxLogBufferSize = 1000000;
+
   /// Sets the loop rate (default 1000 Hz).
-  /// @param[in] hz  rate [Hz], > 0
-  /// @throws std::invalid_argument if not positive or if running
+  /// @param[in] hz  rate [Hz], in (0, kMaxRate]
+  /// @throws std::invalid_argument if out of range or not finite
+  /// @throws std::logic_error if running
   void setRate(double hz);
   /// The loop rate [Hz].
   double getRate() const;
@@ -173,7 +179,8 @@ class ControlProgram {
   /// The log decimation.
   unsigned getLogEvery() const;
   /// Sets the ring-buffer capacity in samples (default 4096).
-  /// @param[in] samples  capacity, >= 2
+  /// @param[in] samples  capacity, 2 .. kMaxLogBufferSize
+  /// @throws std::invalid_argument if out of range; std::logic_error if running
   void setLogBufferSize(std::size_t samples);
   /// Sends this program's samples to `writer` (default: the platform's `-log` writer, if any).
   /// @param[in] writer  log writer that outlives the run, or nullptr for none
