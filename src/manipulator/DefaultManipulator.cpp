@@ -635,6 +635,8 @@ void DefaultManipulator::publish() {
   s.time = getTime();
   s.n = static_cast<int>(q_.size());
   s.power = power_;
+  s.missed = missedCycles_;
+  s.saturated = static_cast<double>(saturatedCycles_.load(std::memory_order_relaxed));
   for (int i = 0; i < s.n; ++i) {
     s.q[i] = q_(i);
     s.qd[i] = qd_(i);
@@ -687,6 +689,17 @@ ControlPanel DefaultManipulator::getControlPanel() const {
   power.kind = FieldKind::Boolean;
   power.stateIndex = 3 * n;
   panel.fields.push_back(power);
+  auto counter = [&](const char* name, const char* label, int index) {
+    ControlPanelField f;
+    f.name = name;
+    f.label = label;
+    f.kind = FieldKind::Number;
+    f.unit = "cycles";
+    f.stateIndex = index;
+    panel.fields.push_back(f);
+  };
+  counter("missed", "Servo cycles missed", 3 * n + 1);
+  counter("saturated", "Cycles at a torque limit", 3 * n + 2);
   return panel;
 }
 
@@ -694,13 +707,15 @@ bool DefaultManipulator::getStateSnapshot(StateSnapshot& snapshot) const {
   PublishedState s = initial_;
   published_.read(s);
   snapshot.time = s.time;
-  snapshot.size = 3 * s.n + 1;
+  snapshot.size = 3 * s.n + 3;
   for (int i = 0; i < s.n; ++i) {
     snapshot.values[i] = s.q[i];
     snapshot.values[s.n + i] = s.qd[i];
     snapshot.values[2 * s.n + i] = s.tau[i];
   }
   snapshot.values[3 * s.n] = s.power ? 1 : 0;
+  snapshot.values[3 * s.n + 1] = s.missed;
+  snapshot.values[3 * s.n + 2] = s.saturated;
   return true;
 }
 

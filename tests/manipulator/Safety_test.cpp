@@ -65,6 +65,17 @@ class FailingControl : public ServoControl {
   char how_;
 };
 
+// The value of the control-panel field `name` in the object's published state (what a Scene
+// Viewer page shows).
+double panelValue(const RoboticObject& object, const std::string& name) {
+  StateSnapshot snapshot;
+  EXPECT_TRUE(object.getStateSnapshot(snapshot));
+  for (const ControlPanelField& f : object.getControlPanel().fields)
+    if (f.name == name && f.stateIndex >= 0 && f.stateIndex < snapshot.size) return snapshot.values[f.stateIndex];
+  ADD_FAILURE() << "no panel field " << name;
+  return -1;
+}
+
 // Shutdown completed by the servo loop: power off, the state still finite.
 void expectSafeStop(Puma560& puma) {
   ASSERT_TRUE(ObjectManager::waitForShutdown(10));
@@ -135,6 +146,7 @@ TEST_F(SafetyTest, ATorqueAtTheLimitPlusGravityIsSaturatedNotAFault) {
   EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
   EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
   EXPECT_GE(puma.getSaturatedCycleCount(), 20u);
+  EXPECT_EQ(panelValue(puma, "saturated"), static_cast<double>(puma.getSaturatedCycleCount()));
   for (int i = 0; i < 6; ++i)
     EXPECT_LE(std::abs(puma.getControlOutput()(i)), puma.getModel().getTorqueLimit()(i)) << "joint " << i + 1;
 }
@@ -255,6 +267,8 @@ TEST(BusyMachine, OnTheRealClockTheSimulatedArmMovesOnThroughAStall) {
     EXPECT_NEAR(across / before, 1.0, 0.25) << "before " << before << " rad/s^2, across the stall " << across;
     EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
     EXPECT_GT(puma.getStatistics().missedCycles, 40u);
+    // The Scene Viewer's panel shows the count (and the log has it in the column `missed`).
+    EXPECT_GT(panelValue(puma, "missed"), 40.0);
   }
   RoboticPlatform::useSimulatedClock();
   ObjectManager::resetShutdown();

@@ -149,6 +149,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
     double time = 0;
     int n = 0;
     bool power = false;
+    double missed = 0, saturated = 0;  // servo cycles missed and saturated so far
     double q[kMaxJoints] = {}, qd[kMaxJoints] = {}, tau[kMaxJoints] = {}, qdes[kMaxJoints] = {};
   };
   struct WrenchBox;
