@@ -86,13 +86,14 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   if (!isSimulationModeOn()) {
     const ConfigSection* section = configSection();
     if (section == nullptr || !section->has("hwserver")) {
-      throw std::runtime_error("manipulator '" + getName() +
-                               "': simulation mode is off but no hardware is configured for it; switch "
-                               "simulation on (-sim, or 'simulationMode on' in rp.cfg) or name a hardware "
-                               "server (rp.cfg 'hwserver NAME')");
+      // No hardware: the arm stays unpowered until the program switches it to simulation
+      // (setSimulationModeOn() right after the declaration, as the paper's Figure 23 does); see
+      // control() and enableArmPower().
+      noHardware_.store(true);
+    } else {
+      if (section->has("countsPerRadian")) countsPerRadian_ = section->getNumbers("countsPerRadian").at(0);
+      board_ = std::make_unique<HwServerIoBoard>(section->getWord("hwserver"));  // throws IoException if absent
     }
-    if (section->has("countsPerRadian")) countsPerRadian_ = section->getNumbers("countsPerRadian").at(0);
-    board_ = std::make_unique<HwServerIoBoard>(section->getWord("hwserver"));  // throws IoException if absent
   }
   const int n = model_->getNumberOfJoints();
   data_ = std::make_unique<ManipulatorData>(*model_);
@@ -187,8 +188,15 @@ void DefaultManipulator::setControlOutput(const Eigen::Ref<const Eigen::VectorXd
   tau_ = torque;
 }
 
+std::string DefaultManipulator::noHardwareMessage() const {
+  return "manipulator '" + getName() +
+         "': simulation mode is off but no hardware is configured for it; switch simulation on (-sim, "
+         "'simulationMode on' in rp.cfg, or setSimulationModeOn()) or name a hardware server (rp.cfg 'hwserver NAME')";
+}
+
 void DefaultManipulator::enableArmPower() {
   if (shutdownPhase_.load() != 0) throw std::logic_error(getName() + ": cannot power the arm during a shutdown");
+  if (noHardware_.load() && !isSimulationModeOn()) throw std::runtime_error(noHardwareMessage());
   powerRequested_.store(true);
 }
 
@@ -197,7 +205,7 @@ void DefaultManipulator::disableArmPower() { powerRequested_.store(false); }
 bool DefaultManipulator::isArmPowerOn() const {
   if (inServoThread()) return power_;
   PublishedState s = initial_;
-  if (!published_.read(s)) return powerRequested_.load();
+  if (!published_.read(s)) return powerRequested_.load() && !noHardware_.load();
   return s.power;
 }
 
@@ -412,9 +420,25 @@ void DefaultManipulator::control() {
   const double dt = getPeriod();
   const int n = model_->getNumberOfJoints();
 
+  // 0. An arm with no hardware waits, unpowered, for setSimulationModeOn(); half a second
+  // without it is a fault (a program that forgot it, or -nosim without the arm's hardware).
+  if (noHardware_.load(std::memory_order_relaxed)) {
+    if (isSimulationModeOn()) {
+      noHardware_.store(false, std::memory_order_relaxed);
+    } else if (++noHardwareCycles_ > static_cast<std::uint64_t>(getRate() / 2) && shutdownPhase_.load() == 0) {
+      std::snprintf(errorBuffer_, sizeof errorBuffer_,
+                    "%.60s: simulation mode is off but no hardware is configured for it (rp.cfg 'hwserver NAME', "
+                    "or simulation on)", nameBuffer_);
+      setError(3, errorBuffer_);
+      shutdownPhase_.store(2, std::memory_order_release);
+      requestSystemShutdown(errorBuffer_);
+    }
+  }
+
   // 1. Commands from other threads, then the joints.
   int phase = shutdownPhase_.load(std::memory_order_acquire);
-  const bool wantPower = powerRequested_.load(std::memory_order_relaxed) && phase == 0;
+  const bool wantPower =
+      powerRequested_.load(std::memory_order_relaxed) && phase == 0 && !noHardware_.load(std::memory_order_relaxed);
   if (wantPower != power_ && phase == 0) {
     power_ = wantPower;
     sim_->setBrakes(!power_);

@@ -10,4 +10,5 @@ printf '[puma]\nclass Puma560\nsimulationMode off\nhwserver %s\n' "$name" > "$wo
 server=$!
 trap 'kill $server 2>/dev/null || true; wait $server 2>/dev/null || true' EXIT
 for _ in $(seq 1 100); do grep -q "serving" "$work/hwserver.log" && break; sleep 0.1; done
-timeout 100 "$program" -nogui -config "$work/rp.cfg"
+# -nosim: the second arm, declared without hardware, is switched to simulation by the program.
+timeout 100 "$program" -nogui -nosim -config "$work/rp.cfg"

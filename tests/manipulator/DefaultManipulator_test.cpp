@@ -389,6 +389,37 @@ TEST_F(ManipulatorTest, ReleasingAServoControlHoldsTheArmWhereItIsNotWhereItWas)
   EXPECT_LT((now - released).norm(), 0.25 * (released - before).norm()) << "held near where it was released";
 }
 
+TEST_F(ManipulatorTest, WithoutHardwareAnArmWaitsUnpoweredForSimulationModeOn) {
+  // The paper's Figure 23 under -nosim: `Puma560 pumaSimulated; pumaSimulated.setSimulationModeOn();`
+  // The declaration used to throw (no hardware configured); now the switch takes effect.
+  RoboticPlatform::setSimulationModeOff();
+  {
+    Puma560 puma;
+    puma.setSimulationModeOn();
+    ASSERT_TRUE(puma.waitForCycles(1000));
+    EXPECT_TRUE(puma.isArmPowerOn());
+    EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
+  }
+  {
+    // Never switched: enableArmPower() says why, and half a second later it is a fault.
+    Puma560 puma("lonely");
+    EXPECT_FALSE(puma.isArmPowerOn());
+    try {
+      puma.enableArmPower();
+      ADD_FAILURE() << "enableArmPower() without hardware or simulation";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("manipulator 'lonely': simulation mode is off but no hardware is configured"),
+                std::string::npos)
+          << e.what();
+    }
+    ASSERT_TRUE(ObjectManager::waitForShutdown(20));
+    EXPECT_NE(puma.getErrorStatus().message.find("lonely: simulation mode is off but no hardware"), std::string::npos)
+        << puma.getErrorStatus().message;
+    EXPECT_FALSE(puma.isArmPowerOn());
+  }
+  RoboticPlatform::setSimulationModeOn();
+}
+
 TEST_F(ManipulatorTest, ARateFromTheQMotorConfigIsThePeriodTheServoControlIntegratesOver) {
   // The qmotorConfig file is applied at the end of the constructor, after the default control
   // took the period: the control must integrate over the new one (2 ms), not the default 1 ms.

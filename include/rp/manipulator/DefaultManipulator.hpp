@@ -62,7 +62,11 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   /// constructor.
   /// @param[in] name          object name; empty for an automatic name
   /// @param[in] modelFactory  makes the model for the given base pose
-  /// @throws std::runtime_error if simulation mode is off and no hardware is configured
+  /// If simulation mode is off and no hardware is configured for the object, the arm stays
+  /// unpowered until the program switches it to simulation (setSimulationModeOn() right after the
+  /// declaration, as the paper's Figure 23 does); enableArmPower() before that throws, and half a
+  /// second without it is a fault (error status and system shutdown, naming the object).
+  /// @throws IoException if the configured hardware server cannot be reached
   DefaultManipulator(const std::string& name, const ModelFactory& modelFactory);
   /// Stops the servo loop.
   ~DefaultManipulator() override;
@@ -83,6 +87,8 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   JointVector getControlOutput() const override;
   void setControlOutput(const Eigen::Ref<const Eigen::VectorXd>& torque) override;
 
+  /// @throws std::runtime_error if simulation mode is off and no hardware is configured
+  /// @throws std::logic_error during a shutdown
   void enableArmPower() override;
   void disableArmPower() override;
   bool isArmPowerOn() const override;
@@ -170,6 +176,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void writeHardware();
   void writeOutputsOff() noexcept;
   void ioFailure(const char* what, int line);
+  std::string noHardwareMessage() const;
 
   std::unique_ptr<ManipulatorModel> model_;
   std::unique_ptr<ManipulatorData> data_;  // servo thread's
@@ -188,6 +195,8 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   std::atomic<bool> gravityCompensation_{true};
   std::atomic<bool> zeroGravity_{false};
   std::atomic<bool> holdHere_{false};
+  std::atomic<bool> noHardware_{false};  // simulation off, no hardware: unpowered until simulation is on
+  std::uint64_t noHardwareCycles_ = 0;
   std::atomic<int> shutdownPhase_{0};  // 0 running, 1 damped hold, 2 complete
   std::atomic<std::thread::id> servoThread_{};
   std::atomic<std::uint64_t> pauseAtCycle_{0};
