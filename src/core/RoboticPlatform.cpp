@@ -55,7 +55,15 @@ void onSignal(int sig) {
   ObjectManager::requestSystemShutdown(sig == SIGINT ? "SIGINT received" : "SIGTERM received");
 }
 
-void atExit() { RoboticPlatform::finish(); }
+void atExit() {
+  RoboticPlatform::finish();
+  // Log (issue 19): a `-log` file that could not be written completely (its writer said why on
+  // stderr and kept the complete rows) ends the run with status 1, not 0.
+  if (LogWriter::hasPlatformWriterFailed()) {
+    std::fflush(nullptr);
+    std::_Exit(1);
+  }
+}
 
 }  // namespace
 
