@@ -1,13 +1,15 @@
 // The log file is never lost: LogWriter refuses a directory and a second run of the same file,
 // writes FIFOs, devices and links in place without replacing them, keeps every complete row when a
 // write fails (file size limit, full tmpfs, reader gone) and leaves after a kill a FILE.part that
-// recoverLog() makes a log of. Failures are injected in child processes (fork).
+// recoverLog() makes a log of. Failures are injected in child processes: the test binary run again
+// (posix_spawn) in a role named by RP_LOG_TEST_CHILD.
 #include "rp/rt/LogWriter.hpp"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sched.h>
 #include <signal.h>
+#include <spawn.h>
 #include <sys/mount.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -17,6 +19,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -117,22 +121,83 @@ void expectCompleteRows(const std::string& text, std::size_t rows) {
   }
 }
 
-// Runs `body` in a child process with stderr into `err`; returns its wait status.
-int inChild(const std::function<int()>& body, const fs::path& err) {
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 2);
-    int rc = 99;
-    try {
-      rc = body();
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "exception: %s\n", e.what());
-    }
-    std::fflush(nullptr);
-    ::_exit(rc);
+// The roles of a child process; its stderr is DIR/stderr.txt, its exit status the result.
+int childMain(const std::string& role, const fs::path& dir) {
+  if (role == "fsize") {  // a file size limit of 20 kB, SIGXFSZ left at its default (a core dump)
+    const rlimit limit{20000, 20000};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    LogWriter writer((dir / "log.csv").string());
+    SimulatedClock clock(1e-3);
+    logCycles(writer, clock, 5000);  // about 150 kB of rows
+    writer.close();
+    return writer.hasFailed() ? 3 : 0;
   }
+  if (role == "fulldisk") {  // a 64 kB tmpfs in a private mount namespace
+    if (::unshare(CLONE_NEWNS) != 0 || ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0 ||
+        ::mount("tmpfs", (dir / "mnt").c_str(), "tmpfs", 0, "size=64k") != 0)
+      return 77;
+    const auto file = dir / "mnt" / "log.csv";
+    bool failed;
+    {
+      LogWriter writer(file.string());
+      SimulatedClock clock(1e-3);
+      logCycles(writer, clock, 10000);  // about 300 kB of rows
+      writer.close();
+      failed = writer.hasFailed();
+    }
+    // The tmpfs disappears with the child: leave a copy of what it holds.
+    fs::copy_file(file, dir / "copy.csv");
+    std::ofstream(dir / "listing.txt") << directory(dir / "mnt").size() << "\n";
+    return failed ? 3 : 0;
+  }
+  if (role == "killed") {  // logs until killed
+    LogWriter writer((dir / "log.csv").string());
+    SimulatedClock clock(1e-3);
+    logCycles(writer, clock, 0);
+    return 0;
+  }
+  return 98;
+}
+
+// In a child process, runs its role before main() and exits.
+const bool kChild = [] {
+  const char* spec = std::getenv("RP_LOG_TEST_CHILD");
+  if (!spec) return false;
+  const std::string role(spec);
+  const auto colon = role.find(':');
+  int rc = 99;
+  try {
+    rc = childMain(role.substr(0, colon), role.substr(colon + 1));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "exception: %s\n", e.what());
+  }
+  std::fflush(nullptr);
+  std::_Exit(rc);
+}();
+
+// Starts this test binary as a child process in `role` working in `dir`.
+pid_t spawnChild(const std::string& role, const fs::path& dir) {
+  std::vector<std::string> env{"RP_LOG_TEST_CHILD=" + role + ":" + dir.string()};
+  for (char** e = environ; *e; ++e) env.emplace_back(*e);
+  std::vector<char*> envp;
+  for (auto& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  std::string self = "/proc/self/exe";
+  char* argv[] = {self.data(), nullptr};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  const std::string err = (dir / "stderr.txt").string();
+  posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  const int e = ::posix_spawn(&pid, self.c_str(), &actions, nullptr, argv, envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  EXPECT_EQ(e, 0) << std::strerror(e);
+  return pid;
+}
+
+// Runs the child in `role` to its end; returns its wait status.
+int runChild(const std::string& role, const fs::path& dir) {
+  const pid_t pid = spawnChild(role, dir);
   int status = 0;
   ::waitpid(pid, &status, 0);
   return status;
@@ -278,17 +343,7 @@ TEST(LogWriterFile, DevicesAreWrittenInPlaceAndAFullOneFails) {
 TEST(LogWriterFile, AFileSizeLimitKeepsEveryCompleteRow) {
   auto dir = scratch("fsize");
   const auto file = dir / "log.csv";
-  const int status = inChild(
-      [&] {
-        const rlimit limit{20000, 20000};
-        ::setrlimit(RLIMIT_FSIZE, &limit);
-        LogWriter writer(file.string());
-        SimulatedClock clock(1e-3);
-        logCycles(writer, clock, 5000);  // about 150 kB of rows
-        writer.close();
-        return writer.hasFailed() ? 3 : 0;
-      },
-      dir / "stderr.txt");
+  const int status = runChild("fsize", dir);
   const std::string err = slurp(dir / "stderr.txt");
   ASSERT_TRUE(WIFEXITED(status)) << "the child died of signal " << WTERMSIG(status) << "\n" << err;
   EXPECT_EQ(WEXITSTATUS(status), 3) << "the writer did not report the failure\n" << err;
@@ -306,26 +361,7 @@ TEST(LogWriterFile, AFileSizeLimitKeepsEveryCompleteRow) {
 TEST(LogWriterFile, AFullDiskKeepsEveryCompleteRow) {
   auto dir = scratch("fulldisk");
   fs::create_directory(dir / "mnt");
-  const int status = inChild(
-      [&] {
-        if (::unshare(CLONE_NEWNS) != 0 || ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0 ||
-            ::mount("tmpfs", (dir / "mnt").c_str(), "tmpfs", 0, "size=64k") != 0)
-          return 77;
-        const auto file = dir / "mnt" / "log.csv";
-        bool failed;
-        {
-          LogWriter writer(file.string());
-          SimulatedClock clock(1e-3);
-          logCycles(writer, clock, 10000);  // about 300 kB of rows
-          writer.close();
-          failed = writer.hasFailed();
-        }
-        // The tmpfs disappears with the child: leave a copy of what it holds.
-        fs::copy_file(file, dir / "copy.csv");
-        std::ofstream(dir / "listing.txt") << directory(dir / "mnt").size() << "\n";
-        return failed ? 3 : 0;
-      },
-      dir / "stderr.txt");
+  const int status = runChild("fulldisk", dir);
   if (WIFEXITED(status) && WEXITSTATUS(status) == 77) GTEST_SKIP() << "cannot mount a tmpfs here";
   const std::string err = slurp(dir / "stderr.txt");
   ASSERT_TRUE(WIFEXITED(status)) << err;
@@ -383,14 +419,7 @@ TEST(LogWriterFile, AKilledRunLeavesAPartThatRecovers) {
   auto dir = scratch("killed");
   const auto file = dir / "log.csv";
   const std::string part = file.string() + ".part";
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    LogWriter writer(file.string());
-    SimulatedClock clock(1e-3);
-    logCycles(writer, clock, 0);  // no cycle limit: runs until killed
-    ::_exit(0);
-  }
+  const pid_t pid = spawnChild("killed", dir);
   std::error_code ec;
   for (int i = 0; i < 3000 && !(fs::file_size(part, ec) > 20000 && !ec); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
