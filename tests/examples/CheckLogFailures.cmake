@@ -4,6 +4,8 @@
 #            failure on stderr, LOG with every complete row, no LOG.part
 #   dir      -log names a directory: status 2, a clear error, nothing created
 #   taken    LOG.part exists (another run, or a killed one): status 2, LOG.part left untouched
+#   devfull  -log names a copy of /dev/full (made with mknod; skipped without CAP_MKNOD): status 1,
+#            the failure on stderr, and the device node is still a device node
 #   pipe     stdout into `head -1`, which exits at once: status 0 and a complete LOG (needs
 #            SIGPIPE ignored by RoboticPlatform::init)
 set(work ${WORK}/log_${CASE})
@@ -69,6 +71,20 @@ elseif(CASE STREQUAL "taken")
   if(NOT rc EQUAL 2 OR NOT err MATCHES "'${log}.part' exists: another run is writing this log" OR EXISTS ${log}
      OR NOT part STREQUAL "t,a.x\n0,1\n")
     message(FATAL_ERROR "status ${rc} (expected 2); ${log}.part: '${part}'")
+  endif()
+elseif(CASE STREQUAL "devfull")
+  execute_process(COMMAND mknod ${work}/full c 1 7 RESULT_VARIABLE rc ERROR_QUIET)
+  if(NOT rc EQUAL 0)
+    message("SKIP: cannot create a device node here")
+    return()
+  endif()
+  execute_process(COMMAND ${run} -log ${work}/full RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err TIMEOUT 60)
+  message("${err}")
+  execute_process(COMMAND stat -c %F ${work}/full OUTPUT_VARIABLE type OUTPUT_STRIP_TRAILING_WHITESPACE)
+  file(GLOB left ${work}/*)
+  if(NOT rc EQUAL 1 OR NOT err MATCHES "rp: log ${work}/full: write failed: No space left on device; 0 complete rows kept"
+     OR NOT type STREQUAL "character special file" OR NOT left STREQUAL "${work}/full")
+    message(FATAL_ERROR "status ${rc} (expected 1), ${work}/full is a ${type}, files: ${left}")
   endif()
 elseif(CASE STREQUAL "pipe")
   execute_process(COMMAND ${run} -log ${log} COMMAND head -1 RESULTS_VARIABLE rcs OUTPUT_VARIABLE out
