@@ -58,13 +58,15 @@ void onSignal(int sig) {
 
 // The last exit handler init() registers runs first at exit: it completes a shutdown in
 // progress (or holds and powers off the arms still running), closes the log, and sets the exit
-// status: 128 + the signal after SIGINT or SIGTERM, kExitAfterShutdown after any other system
-// shutdown (a fault, an emergency stop), else the program's own.
+// status: 128 + the signal after SIGINT or SIGTERM; 1 when the -log file could not be written
+// completely (its writer said why on stderr and kept the complete rows); kExitAfterShutdown
+// after any other system shutdown (a fault, an emergency stop); else the program's own.
 void atExit() {
   RoboticPlatform::finish();
   auto& reg = internal::registry();
   std::fflush(nullptr);
   if (const int sig = reg.signalNumber.load()) _exit(128 + sig);
+  if (LogWriter::hasPlatformWriterFailed()) _exit(1);
   if (ObjectManager::isShutdownRequested()) {
     std::fprintf(stderr, "rp: the program ends after a system shutdown (%s): exit status %d\n",
                  ObjectManager::getShutdownReason().c_str(), RoboticPlatform::kExitAfterShutdown);
@@ -208,6 +210,10 @@ void RoboticPlatform::init(int& argc, char** argv, const std::string& programUsa
   if (!getLogFileName().empty()) {
     try {
       LogWriter::openPlatformWriter(getLogFileName());
+      // A log that can no longer be written ends the run: the arms are held and powered off
+      // (a system shutdown), the complete rows are kept, and the exit status is 1.
+      LogWriter::getPlatformWriter()->setFailureHandler(
+          [](const std::string&) { ObjectManager::requestSystemShutdown("the -log file cannot be written"); });
     } catch (const std::exception& e) {
       std::cerr << program << ": -log: " << e.what() << "\n";
       std::exit(2);

@@ -1,13 +1,17 @@
 // LogWriter: drains the programs' ring buffers in a non-real-time thread and writes one CSV file.
 #include "rp/rt/LogWriter.hpp"
 
+#include <pthread.h>
+#include <signal.h>
+
 #include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
-#include <fstream>
+#include <cstring>
+#include <functional>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -16,6 +20,7 @@
 #include <vector>
 
 #include "LogChannel.hpp"
+#include "LogFile.hpp"
 
 namespace rp {
 
@@ -24,6 +29,11 @@ namespace {
 struct Row {
   std::vector<double> values;
   std::vector<char> present;
+};
+
+struct Line {
+  std::size_t end;  // offset after its '\n' in the text written
+  bool row;         // a row (else a header line)
 };
 
 void appendNumber(std::string& out, double v) {
@@ -35,19 +45,27 @@ void appendNumber(std::string& out, double v) {
 }  // namespace
 
 struct LogWriter::Impl {
-  std::string fileName, partName;
-  std::FILE* part = nullptr;
-  std::mutex mutex;  // channels, staging, file
+  explicit Impl(const std::string& name) : fileName(name), file(name) {}
+
+  std::string fileName;
+  internal::LogFile file;  // touched only by the writer thread once it runs
+  std::mutex mutex;        // channels, staging, the writer's state below
   std::condition_variable cv;
   std::vector<std::shared_ptr<Channel>> channels;
   std::size_t totalColumns = 0;
   std::map<double, Row> staging;
   std::thread thread;
+  std::thread::id threadId;
   bool stopping = false;
   std::mutex closeMutex;
   std::atomic<bool> closed{false};
   std::atomic<std::uint64_t> rows{0};
-  bool logging = true;  // with `mutex`: samples drained while false are not written to the file
+  bool logging = true;          // with `mutex`: samples drained while false are not written to the file
+  std::size_t headerWidth = 0;  // with `mutex`: columns of the last header line given to the file (0: none)
+  bool headerGrew = false;      // with `mutex`: a wider header followed rows (the file needs rewriting)
+  std::atomic<bool> failed{false};
+  std::string error;                                    // with `mutex`: why, once `failed`
+  std::function<void(const std::string&)> onFailure;  // with `mutex`
   // The newest samples of each channel (index as `channels`), each 1 + width doubles; kept only
   // from the first getRecentSamples() call on (a log nobody plots costs nothing more).
   struct History {
@@ -62,9 +80,10 @@ struct LogWriter::Impl {
   std::vector<History> recent;
   bool keepRecent = false;
 
-  // With `mutex` held: moves every available sample into `staging`, then writes the rows no
-  // program can add to any more (all times up to the slowest running program's last sample).
-  void drain(bool all) {
+  // With `mutex` held: moves every available sample into `staging` (or, while not logging or
+  // after a failed write, only into the plot history).
+  void collect() {
+    const bool toFile = logging && !failed.load();
     for (std::size_t k = 0; k < channels.size(); ++k) {
       auto& c = channels[k];
       while (const double* s = c->front()) {
@@ -74,68 +93,140 @@ struct LogWriter::Impl {
           if (history.samples.empty()) history.samples.resize(LogWriter::kRecentSamples * stride);
           std::copy(s, s + stride, &history.samples[(history.count++ % LogWriter::kRecentSamples) * stride]);
         }
-        if (!logging) {  // stopped: the sample is only kept for the plots
-          c->lastTime = s[0];
-          c->any = true;
-          c->pop();
-          continue;
-        }
-        Row& row = staging[s[0]];
-        if (row.values.size() < totalColumns) {
-          row.values.resize(totalColumns, 0.0);
-          row.present.resize(totalColumns, 0);
-        }
-        for (std::size_t i = 0; i < c->width; ++i) {
-          row.values[c->firstColumn + i] = s[i + 1];
-          row.present[c->firstColumn + i] = 1;
+        if (toFile) {
+          Row& row = staging[s[0]];
+          if (row.values.size() < totalColumns) {
+            row.values.resize(totalColumns, 0.0);
+            row.present.resize(totalColumns, 0);
+          }
+          for (std::size_t i = 0; i < c->width; ++i) {
+            row.values[c->firstColumn + i] = s[i + 1];
+            row.present[c->firstColumn + i] = 1;
+          }
         }
         c->lastTime = s[0];
         c->any = true;
         c->pop();
       }
     }
+  }
+
+  // With `mutex` held: appends to `out` the header line with every column so far.
+  void appendHeader(std::string& out, std::vector<Line>& lines) {
+    if (headerWidth > 0) headerGrew = true;
+    out += 't';
+    for (auto& c : channels)
+      for (auto& column : c->columns) {
+        out += ',';
+        out += column;
+      }
+    out += '\n';
+    headerWidth = totalColumns + 1;
+    lines.push_back({out.size(), false});
+  }
+
+  // With `mutex` held: appends to `out` the rows no program can add to any more (all times up to
+  // the slowest running program's last sample; every row when `all`), each after a header line
+  // naming its columns.
+  void appendRows(bool all, std::string& out, std::vector<Line>& lines) {
     double watermark = std::numeric_limits<double>::infinity();
     if (!all)
       for (auto& c : channels)
         if (c->any && !c->finished.load()) watermark = std::min(watermark, c->lastTime);
-    std::string line;
     while (!staging.empty() && staging.begin()->first <= watermark) {
       auto node = staging.extract(staging.begin());
-      line.clear();
-      appendNumber(line, node.key());
+      if (headerWidth != totalColumns + 1) appendHeader(out, lines);
+      appendNumber(out, node.key());
       const Row& row = node.mapped();
-      for (std::size_t i = 0; i < row.values.size(); ++i) {
-        line += ',';
-        if (row.present[i]) appendNumber(line, row.values[i]);
+      for (std::size_t i = 0; i + 1 < headerWidth; ++i) {
+        out += ',';
+        if (i < row.values.size() && row.present[i]) appendNumber(out, row.values[i]);
       }
-      line += '\n';
-      std::fwrite(line.data(), 1, line.size(), part);
-      rows.fetch_add(1);
+      out += '\n';
+      lines.push_back({out.size(), true});
     }
+  }
+
+  // The writer thread, without `mutex`: writes `out` and counts what reached the file; on the
+  // first failure says so at once and writes nothing more.
+  void write(const std::string& out, const std::vector<Line>& lines) {
+    if (out.empty()) return;
+    std::size_t kept = 0;
+    const int e = file.write(out, kept);
+    std::uint64_t written = 0;
+    for (const Line& line : lines)
+      if (line.end <= kept && line.row) ++written;
+    rows.fetch_add(written);
+    if (e != 0) fail(std::string("write failed: ") + std::strerror(e));
+  }
+
+  // Records the first failure, tells stderr at once and calls the failure handler.
+  void fail(const std::string& what) {
+    std::function<void(const std::string&)> handler;
+    std::string message;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (failed.load()) return;
+      message = what + "; " + std::to_string(rows.load()) + " complete rows kept";
+      error = message;
+      failed = true;
+      staging.clear();
+      handler = onFailure;
+    }
+    std::fprintf(stderr, "rp: log %s: %s\n", fileName.c_str(), message.c_str());
+    std::fflush(stderr);
+    if (handler) handler(message);
   }
 
   void run() {
-    std::unique_lock<std::mutex> lock(mutex);
-    while (!stopping) {
-      cv.wait_for(lock, std::chrono::milliseconds(20));
-      drain(false);
+    // A reader that went away (SIGPIPE) or a file size limit (SIGXFSZ) fails the write instead of
+    // ending the process: the rows written so far are kept and the run ends normally.
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGPIPE);
+    sigaddset(&signals, SIGXFSZ);
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    std::string out;
+    std::vector<Line> lines;
+    bool last = false, rewrite = false;
+    while (!last) {
+      out.clear();
+      lines.clear();
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        if (!stopping) cv.wait_for(lock, std::chrono::milliseconds(20));
+        last = stopping;
+        collect();
+        if (!failed.load()) {
+          appendRows(last, out, lines);
+          // The complete log has a header with every column, even without rows.
+          if (last && headerWidth != totalColumns + 1) appendHeader(out, lines);
+        }
+        rewrite = headerGrew;
+      }
+      write(out, lines);
     }
+    const std::string error = file.finish(rewrite && !file.isDirect());
+    if (!error.empty() && failed.load())
+      std::fprintf(stderr, "rp: log %s: %s\n", fileName.c_str(), error.c_str());
+    else if (!error.empty())
+      fail(error);
+    else if (failed.load() && !file.isDirect())
+      std::fprintf(stderr, "rp: log %s: incomplete: its %llu complete rows are in %s\n", fileName.c_str(),
+                   static_cast<unsigned long long>(rows.load()), fileName.c_str());
   }
 };
 
-LogWriter::LogWriter(const std::string& fileName) : impl_(std::make_unique<Impl>()) {
-  impl_->fileName = fileName;
-  impl_->partName = fileName + ".part";
-  impl_->part = std::fopen(impl_->partName.c_str(), "w");
-  if (!impl_->part) throw std::runtime_error("LogWriter: cannot create '" + impl_->partName + "'");
+LogWriter::LogWriter(const std::string& fileName) : impl_(std::make_unique<Impl>(fileName)) {
   impl_->thread = std::thread([this] { impl_->run(); });
+  impl_->threadId = impl_->thread.get_id();
 }
 
 LogWriter::~LogWriter() { close(); }
 
 void LogWriter::addChannel(const std::shared_ptr<Channel>& channel) {
   std::lock_guard<std::mutex> lock(impl_->mutex);
-  if (impl_->closed.load()) return;
+  if (impl_->stopping) return;
   // Column names must be unique: a second program of the same name becomes name_2, name_3, ...
   auto taken = [&](const std::string& name) {
     for (auto& c : impl_->channels)
@@ -160,14 +251,14 @@ void LogWriter::addChannel(const std::shared_ptr<Channel>& channel) {
 void LogWriter::stopLogging() {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   if (impl_->closed.load() || !impl_->logging) return;
-  impl_->drain(false);  // what was taken before this call goes to the file
+  impl_->collect();  // what was taken before this call goes to the file
   impl_->logging = false;
 }
 
 void LogWriter::startLogging() {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   if (impl_->closed.load() || impl_->logging) return;
-  impl_->drain(false);  // what was taken while stopped stays out of the file
+  impl_->collect();  // what was taken while stopped stays out of the file
   impl_->logging = true;
 }
 
@@ -187,7 +278,7 @@ std::vector<LogSeries> LogWriter::getRecentSamples(const std::vector<std::string
                                                    std::size_t maxSamples) const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   impl_->keepRecent = true;
-  if (!impl_->closed.load()) impl_->drain(false);  // include what the programs took since the last pass
+  if (!impl_->closed.load()) impl_->collect();  // include what the programs took since the last pass
   std::vector<LogSeries> out;
   for (const std::string& name : columns) {
     LogSeries series;
@@ -218,6 +309,7 @@ std::vector<LogSeries> LogWriter::getRecentSamples(const std::vector<std::string
 void LogWriter::notify() { impl_->cv.notify_all(); }
 
 void LogWriter::close() {
+  if (std::this_thread::get_id() == impl_->threadId) return;  // from the failure handler: the writer ends itself
   std::lock_guard<std::mutex> closeLock(impl_->closeMutex);
   if (impl_->closed.load()) return;
   {
@@ -225,42 +317,34 @@ void LogWriter::close() {
     impl_->stopping = true;
   }
   impl_->cv.notify_all();
-  impl_->thread.join();
-  std::vector<std::string> header{"t"};
+  impl_->thread.join();  // the thread writes the last rows and completes the file
   std::uint64_t lost = 0;
   {
     std::lock_guard<std::mutex> lock(impl_->mutex);
-    impl_->drain(true);
-    std::fclose(impl_->part);
-    impl_->part = nullptr;
-    for (auto& c : impl_->channels) {
-      header.insert(header.end(), c->columns.begin(), c->columns.end());
-      lost += c->lost.load();
-    }
-    impl_->closed = true;
+    for (auto& c : impl_->channels) lost += c->lost.load();
   }
-  // The complete file: the header with every column, then the rows padded to full width.
-  const std::string tmp = impl_->fileName + ".tmp";
-  {
-    std::ifstream in(impl_->partName);
-    std::ofstream out(tmp);
-    std::string line;
-    for (std::size_t i = 0; i < header.size(); ++i) line += (i ? "," : "") + header[i];
-    out << line << '\n';
-    while (std::getline(in, line)) {
-      std::size_t fields = 1;
-      for (char ch : line) fields += ch == ',';
-      if (fields < header.size()) line.append(header.size() - fields, ',');
-      out << line << '\n';
-    }
-    out.flush();
-    if (!out) std::fprintf(stderr, "rp: log %s: write error\n", impl_->fileName.c_str());
-  }
-  std::rename(tmp.c_str(), impl_->fileName.c_str());
-  std::remove(impl_->partName.c_str());
+  impl_->closed = true;
   if (lost > 0)
     std::fprintf(stderr, "rp: log %s: %llu samples lost because a ring buffer was full (raise logBufferSize)\n",
                  impl_->fileName.c_str(), static_cast<unsigned long long>(lost));
+}
+
+bool LogWriter::hasFailed() const { return impl_->failed.load(); }
+
+std::string LogWriter::getError() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->error;
+}
+
+void LogWriter::setFailureHandler(std::function<void(const std::string& message)> handler) {
+  std::string error;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->onFailure = handler;
+    if (!impl_->failed.load()) return;
+    error = impl_->error;
+  }
+  if (handler) handler(error);  // it failed already
 }
 
 bool LogWriter::isClosed() const { return impl_->closed.load(); }
@@ -300,6 +384,11 @@ void LogWriter::openPlatformWriter(const std::string& fileName) {
 void LogWriter::closePlatformWriter() {
   LogWriter* w = getPlatformWriter();
   if (w) w->close();
+}
+
+bool LogWriter::hasPlatformWriterFailed() {
+  LogWriter* w = getPlatformWriter();
+  return w && w->hasFailed();
 }
 
 }  // namespace rp

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,15 +26,23 @@ struct LogSeries {
 /// Format: a header `t,program.variable,program.vector[0],...` and one row per sample time;
 /// samples of different programs taken at the same clock time share a row, other cells are
 /// empty. Values are written with the shortest text that reads back to the same double.
-/// While running, rows go to `FILE.part`; close() (called by stop, system shutdown, SIGINT,
-/// SIGTERM and normal exit) drains every ring buffer and writes the complete `FILE`.
+/// While running, rows go to `FILE.part` (created exclusively: a second run with the same FILE is
+/// refused); close() (called by stop, system shutdown, SIGINT, SIGTERM and normal exit) drains
+/// every ring buffer and renames it to `FILE`. A FILE that is not a regular file (a FIFO,
+/// `/dev/null`, a terminal, a symbolic link) is written in place and never replaced; a directory
+/// is refused. Every write is checked: on the first failure (a full disk, a file size limit, a
+/// reader gone) the writer says so on stderr at once, cuts the file back to its last complete row,
+/// writes nothing more and hasFailed() turns true; close() still completes FILE with the rows
+/// kept. After a kill, recoverLog() (`rp-log recover FILE.part`) makes a log of `FILE.part`.
 /// No sample is lost unless a program's ring buffer overflows; losses are counted
 /// (ControlStatistics::lostLogSamples, getLostSamples()) and reported on close.
 class LogWriter {
  public:
   /// Opens the log and starts the writer thread.
   /// @param[in] fileName  CSV file to write
-  /// @throws std::runtime_error if `FILE.part` cannot be created
+  /// @throws std::runtime_error naming FILE if it is a directory (or a block device, a dangling
+  ///         link, a FIFO nobody reads), if `FILE.part` exists (another run, or a killed one) or
+  ///         cannot be created
   explicit LogWriter(const std::string& fileName);
   /// Closes the log (see close()).
   ~LogWriter();
@@ -51,6 +60,22 @@ class LogWriter {
   std::uint64_t getRowCount() const;
   /// Samples lost to ring-buffer overflow, summed over programs.
   std::uint64_t getLostSamples() const;
+
+  /// @name Failures
+  /// @{
+
+  /// Whether a write, sync, close or the completion of FILE failed: the log is incomplete (it
+  /// holds the complete rows written before the failure). A program should end with a non-zero
+  /// status then.
+  bool hasFailed() const;
+  /// What failed, e.g. `write failed: No space left on device; 1200 complete rows kept`, or "".
+  std::string getError() const;
+  /// Calls `handler` once, with getError(), on the first failure (from the writer's thread, at once;
+  /// it must not block; close() called there returns at once, the writer ends by itself), or right
+  /// away if the log has failed already. E.g. request a system shutdown there to end the run.
+  /// @param[in] handler  called with the message; an empty function removes the handler
+  void setFailureHandler(std::function<void(const std::string& message)> handler);
+  /// @}
 
   /// @name Starting and stopping (QMotor's start/stop logging)
   /// @{
@@ -92,9 +117,12 @@ class LogWriter {
   static LogWriter* getPlatformWriter();
   /// Creates the platform's writer (RoboticPlatform::init does this for `-log`).
   /// @param[in] fileName  CSV file
+  /// @throws std::runtime_error as LogWriter()
   static void openPlatformWriter(const std::string& fileName);
   /// Closes the platform's writer, completing its file.
   static void closePlatformWriter();
+  /// Whether the platform's writer exists and hasFailed() (the program should end with a non-zero status).
+  static bool hasPlatformWriterFailed();
 
   /// @cond INTERNAL
   struct Channel;

@@ -7,6 +7,7 @@
 #include "rp/rt/Client.hpp"
 #include "rp/rt/Clock.hpp"
 #include "rp/rt/ControlProgram.hpp"
+#include "rp/rt/LogRecovery.hpp"
 #include "rp/rt/LogWriter.hpp"
 #include "rp/rt/ReaderWriterLock.hpp"
 #include "rp/rt/Server.hpp"
