@@ -40,7 +40,8 @@ int main(int argc, char** argv) {
                                                    : rp::HwServerIoBoard::Heartbeat::kOperations);
     auto writeAll = [&]() {
       rp::IoStatus s = board.writeDigitalOutput(0, true);
-      for (int i = 0; i < board.numAnalogOutputs() && s == rp::IoStatus::kOk; ++i) s = board.writeAnalogOutput(i, volts);
+      for (int i = 0; i < board.numAnalogOutputs() && s == rp::IoStatus::kOk; ++i)
+        s = board.writeAnalogOutput(i, volts);
       return s;
     };
     if (writeAll() != rp::IoStatus::kOk || board.confirmWrites(5000) != rp::IoStatus::kOk) {
