@@ -99,7 +99,8 @@ bool driveTwoLines(IoBoard& board, int lineA, bool valueA, int lineB, bool value
   // Done only when the device has both (through a hardware server: after the server wrote them
   // and the board accepted them; other boards answer each write at once).
   if (board.writeDigitalOutput(first, firstValue) != IoStatus::kOk ||
-      board.writeDigitalOutput(second, secondValue) != IoStatus::kOk || board.confirmWrites(kConfirmTimeoutMs) != IoStatus::kOk) {
+      board.writeDigitalOutput(second, secondValue) != IoStatus::kOk ||
+      board.confirmWrites(kConfirmTimeoutMs) != IoStatus::kOk) {
     error = board.lastError();
     return false;
   }

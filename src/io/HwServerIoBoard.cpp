@@ -106,10 +106,18 @@ void HwServerIoBoard::waitForGoneClientsOutputsOff() {
     const std::int64_t now = internal::monotonicNs();
     int stillOn = -1;
     const char* kind = "";
-    for (int i = 0; i < shm_->numDigitalOutputs && stillOn < 0; ++i)
-      if (shm_->digitalOutApplied[i].load() != 0 && !live(shm_->digitalOutOwner[i].load(), now)) stillOn = i, kind = "digital";
-    for (int i = 0; i < shm_->numAnalogOutputs && stillOn < 0; ++i)
-      if (shm_->analogOutApplied[i].load() != 0.0 && !live(shm_->analogOutOwner[i].load(), now)) stillOn = i, kind = "analog";
+    for (int i = 0; i < shm_->numDigitalOutputs && stillOn < 0; ++i) {
+      if (shm_->digitalOutApplied[i].load() != 0 && !live(shm_->digitalOutOwner[i].load(), now)) {
+        stillOn = i;
+        kind = "digital";
+      }
+    }
+    for (int i = 0; i < shm_->numAnalogOutputs && stillOn < 0; ++i) {
+      if (shm_->analogOutApplied[i].load() != 0.0 && !live(shm_->analogOutOwner[i].load(), now)) {
+        stillOn = i;
+        kind = "analog";
+      }
+    }
     if (stillOn < 0) return;
     if (shm_->state.load() != static_cast<std::int32_t>(internal::HwServerState::kRunning) || now > deadline)
       throw IoException("HwServerIoBoard: hardware server '" + name_ + "' still has " + kind + " output " +
@@ -121,7 +129,8 @@ void HwServerIoBoard::waitForGoneClientsOutputsOff() {
 
 void HwServerIoBoard::keepAlive() {
   // A few beats per watchdog time, at most every 10 ms.
-  const auto period = std::chrono::nanoseconds(std::clamp<std::int64_t>(shm_->watchdogNs.load() / 4, 100'000, 10'000'000));
+  const auto period =
+      std::chrono::nanoseconds(std::clamp<std::int64_t>(shm_->watchdogNs.load() / 4, 100'000, 10'000'000));
   std::unique_lock lock(keepAliveMutex_);
   while (!stopKeepAlive_) {
     shm_->clients[slot_].heartbeatNs.store(internal::monotonicNs());

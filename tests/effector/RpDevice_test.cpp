@@ -59,7 +59,7 @@ class RpDeviceThroughHwServer : public RpDevice {
     name_ = name_.substr(0, 64);
     server_ = std::make_unique<test::ChildProcess>(std::vector<std::string>{
         RP_HWSERVER_PATH, "-name", name_, "-rate", "20", "-board", "modbus", "-port", std::to_string(port), "-timeout",
-        "200", "-coils", coils, "-discreteInputs", "0"});
+        "200", "-watchdog", "5000", "-coils", coils, "-discreteInputs", "0"});
     const auto line = server_->readLine(10000);
     ASSERT_TRUE(line.has_value() && contains(*line, "serving")) << line.value_or("(nothing)");
   }

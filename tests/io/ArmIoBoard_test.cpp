@@ -83,7 +83,9 @@ TEST(ArmIoBoard, DacsRefuseNaNAndClampToTheirRange) {
 
 TEST(RpHwServer, PumaBackendMovesTheArmOnDacVolts) {
   const std::string name = "test-puma-" + std::to_string(::getpid());
-  test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "500", "-board", "puma560"});
+  // A long client watchdog: this test is not about it, and a loaded machine may pause the client.
+  test::ChildProcess server(
+      {RP_HWSERVER_PATH, "-name", name, "-rate", "500", "-board", "puma560", "-watchdog", "5000"});
   const auto line = server.readLine(10000);
   ASSERT_TRUE(line.has_value());
   EXPECT_NE(line->find("6 AO, 6 encoders"), std::string::npos) << *line;

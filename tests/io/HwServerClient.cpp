@@ -9,7 +9,9 @@
 //   return     returns from main normally (the client's destructor detaches it)
 //   exit       _exit(0) after the writes: no destructor, no cleanup
 //   throw      an uncaught exception (std::terminate, SIGABRT)
+// return, exit and throw wait for SIGUSR1 after "ready", so that the test sees the outputs on first.
 // Exit status 2 for bad arguments, 1 if the server cannot be reached.
+#include <signal.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -28,13 +30,18 @@ int main(int argc, char** argv) {
   }
   const std::string name = argv[1], mode = argv[3];
   const double volts = std::atof(argv[2]);
+  sigset_t go;
+  sigemptyset(&go);
+  sigaddset(&go, SIGUSR1);
+  pthread_sigmask(SIG_BLOCK, &go, nullptr);  // delivered by sigwait below only
   try {
     rp::HwServerIoBoard board(name, 2000,
                               mode == "background" ? rp::HwServerIoBoard::Heartbeat::kBackgroundThread
                                                    : rp::HwServerIoBoard::Heartbeat::kOperations);
     auto writeAll = [&]() {
       rp::IoStatus s = board.writeDigitalOutput(0, true);
-      for (int i = 0; i < board.numAnalogOutputs() && s == rp::IoStatus::kOk; ++i) s = board.writeAnalogOutput(i, volts);
+      for (int i = 0; i < board.numAnalogOutputs() && s == rp::IoStatus::kOk; ++i)
+        s = board.writeAnalogOutput(i, volts);
       return s;
     };
     if (writeAll() != rp::IoStatus::kOk || board.confirmWrites(5000) != rp::IoStatus::kOk) {
@@ -57,6 +64,8 @@ int main(int argc, char** argv) {
     if (mode == "idle" || mode == "background") {
       while (true) ::pause();
     }
+    int sig = 0;
+    sigwait(&go, &sig);
     if (mode == "exit") ::_exit(0);
     if (mode == "throw") throw std::runtime_error("calculate() failed");
     if (mode != "return") return 2;

@@ -26,11 +26,15 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 // Unique per process and test, so that ctest -j runs do not collide.
 std::string uniqueName(const char* what) { return std::string("test-") + what + "-" + std::to_string(::getpid()); }
 
+// These tests are not about the client watchdog (HwServerWatchdog_test is): a watchdog time long
+// enough that a client descheduled on a loaded machine keeps its outputs.
+constexpr double kLongWatchdogMs = 5000.0;
+
 TEST(HwServer, ServesABoardToSeveralClients) {
   SimulatedIoBoard board({.digitalInputs = 4, .digitalOutputs = 4, .analogInputs = 2, .analogOutputs = 2,
                           .encoders = 2, .analogRange = 10.0, .loopback = true});
   board.setEncoder(1, 4242);
-  HwServer server(board, uniqueName("inproc"), 500.0);
+  HwServer server(board, uniqueName("inproc"), 500.0, kLongWatchdogMs);
   server.start();
   HwServerIoBoard a(server.name());
   HwServerIoBoard b(server.name());
@@ -61,7 +65,7 @@ TEST(HwServer, ServesABoardToSeveralClients) {
 TEST(HwServer, ClientRefusesNaNAndTheServersBoardClamps) {
   SimulatedIoBoard board({.digitalInputs = 0, .digitalOutputs = 0, .analogInputs = 0, .analogOutputs = 2,
                           .encoders = 0, .analogRange = 10.0, .loopback = false});
-  HwServer server(board, uniqueName("nan"), 500.0);
+  HwServer server(board, uniqueName("nan"), 500.0, kLongWatchdogMs);
   server.start();
   HwServerIoBoard client(server.name());
   ASSERT_EQ(client.writeAnalogOutput(0, 3.0), IoStatus::kOk);
@@ -79,7 +83,7 @@ TEST(HwServer, ClientRefusesNaNAndTheServersBoardClamps) {
 
 TEST(HwServer, ClientOperationsDoNotAllocate) {
   SimulatedIoBoard board;
-  HwServer server(board, uniqueName("alloc"), 200.0);
+  HwServer server(board, uniqueName("alloc"), 200.0, kLongWatchdogMs);
   server.start();
   HwServerIoBoard client(server.name());
   bool b = false;
@@ -123,7 +127,8 @@ TEST(HwServer, RejectsBadNamesAndRates) {
 
 TEST(RpHwServer, ServesASimulatedBoardAndDetectsItsDeath) {
   const std::string name = uniqueName("child");
-  test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "200", "-board", "simulated", "-loopback"});
+  test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "200", "-board", "simulated", "-loopback",
+                              "-watchdog", "5000"});
   const auto line = server.readLine(10000);
   ASSERT_TRUE(line.has_value());
   EXPECT_TRUE(contains(*line, "rp-hwserver: serving " + name)) << *line;
@@ -158,8 +163,8 @@ TEST(RpHwServer, DrivesModbusCoilsAndReportsTheBoardFailing) {
   device.setDiscreteInput(1, true);
   const std::string name = uniqueName("modbus");
   test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "100", "-board", "modbus", "-port",
-                             std::to_string(device.port()), "-timeout", "100", "-coils", "4,5", "-discreteInputs",
-                             "0,1"});
+                             std::to_string(device.port()), "-timeout", "100", "-watchdog", "5000", "-coils", "4,5",
+                             "-discreteInputs", "0,1"});
   const auto line = server.readLine(10000);
   ASSERT_TRUE(line.has_value());
   EXPECT_TRUE(contains(*line, "2 DI, 2 DO")) << *line;

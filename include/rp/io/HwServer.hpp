@@ -30,7 +30,7 @@ struct HwServerShm;
 /// publishes a heartbeat of its own (`HwServerIoBoard`). When a client falls silent for longer
 /// than the watchdog time (killed, stopped, hung) while one of its outputs is on, or detaches, or
 /// its process is gone, the server writes its outputs off (digital false, analog 0 V) in its next
-/// cycle: within watchdog time + one period of the client's last operation. A silent client
+/// cycle: within the watchdog time plus one server period after its last operation. A silent client
 /// that wakes up again finds its writes refused (`kNotConnected`) until it attaches anew, so it
 /// cannot switch amplifiers back on with stale commands.
 ///
