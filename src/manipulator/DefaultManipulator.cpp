@@ -104,7 +104,7 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   q_ = sim_->getPosition();
   if (board_) {
     velocity_ = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
-    if (!readHardware()) {
+    if (!readHardware(getPeriod())) {
       throw std::runtime_error("manipulator '" + getName() + "': cannot read the joints: " + board_->lastError());
     }
   }
@@ -354,13 +354,15 @@ void DefaultManipulator::declareSettings(SettingSchema& schema) {
   schema.addNumbers("countsPerRadian", 1, "counts/rad", "encoder counts per joint radian");
 }
 
-bool DefaultManipulator::readHardware() {
+bool DefaultManipulator::readHardware(double elapsed) {
   for (int i = 0; i < q_.size(); ++i) {
     std::int64_t counts = 0;
     if (board_->readEncoder(i, counts) != IoStatus::kOk) return false;
     q_(i) = static_cast<double>(counts) / countsPerRadian_;
   }
-  qd_ = velocity_->differentiate(q_);
+  // Over the time that really passed: after a stalled cycle the encoders moved for several
+  // periods, which divided by one period would be a velocity spike (and a false velocity fault).
+  qd_ = velocity_->differentiate(q_, elapsed);
   return true;
 }
 
@@ -446,7 +448,7 @@ void DefaultManipulator::control() {
     if (power_) activeControl_ = nullptr;  // activate() again below
   }
   if (board_) {
-    if (!readHardware()) ioFailure("reading the encoders", 0);
+    if (!readHardware(lastCycleTime_ >= 0 && t > lastCycleTime_ ? t - lastCycleTime_ : dt)) ioFailure("reading the encoders", 0);
   } else {
     // On the real clock a cycle delayed by a busy machine skips deadlines; the arm moved on under
     // the last torque (still in tau_) meanwhile, as a real one does: integrate that time, in

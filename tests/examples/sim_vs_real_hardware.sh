@@ -6,7 +6,8 @@ hwserver=$1 program=$2 work=$3
 name="svr-$$"
 mkdir -p "$work"
 printf '[puma]\nclass Puma560\nsimulationMode off\nhwserver %s\n' "$name" > "$work/rp.cfg"
-"$hwserver" -name "$name" -rate 1000 -board puma560 -duration 120 > "$work/hwserver.log" 2>&1 &
+# -watchdog 5000: a servo loop stalled by a loaded test machine is not cut off by the server.
+"$hwserver" -name "$name" -rate 1000 -board puma560 -watchdog 5000 -duration 120 > "$work/hwserver.log" 2>&1 &
 server=$!
 trap 'kill $server 2>/dev/null || true; wait $server 2>/dev/null || true' EXIT
 for _ in $(seq 1 100); do grep -q "serving" "$work/hwserver.log" && break; sleep 0.1; done

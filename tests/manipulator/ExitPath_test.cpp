@@ -99,7 +99,7 @@ class HardwareExitPath : public ::testing::Test {
     std::filesystem::create_directories(dir_);
     std::ofstream(dir_ / "rp.cfg") << "[puma]\nclass Puma560\nsimulationMode off\nhwserver " << name_ << "\n";
     server_ = std::make_unique<test::ChildProcess>(
-        std::vector<std::string>{RP_HWSERVER_PATH, "-name", name_, "-rate", "1000", "-board", "puma560"});
+        std::vector<std::string>{RP_HWSERVER_PATH, "-name", name_, "-rate", "1000", "-board", "puma560", "-watchdog", "1000"});
     ASSERT_TRUE(server_->readLine(10000).has_value()) << "the server did not start";
     monitor_ = std::make_unique<HwServerIoBoard>(name_);
   }
@@ -118,9 +118,10 @@ class HardwareExitPath : public ::testing::Test {
     }
     return true;
   }
-  // Waits (generously: the machine may be loaded) until the outputs are off.
+  // Waits (generously: the machine may be loaded) until the outputs are off. The server's
+  // watchdog is 1 s here, so outputs off well before that were switched off by the program.
   bool waitUntilOff() {
-    for (int i = 0; i < 5000; ++i) {
+    for (int i = 0; i < 10000; ++i) {
       if (outputsOff()) return true;
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }

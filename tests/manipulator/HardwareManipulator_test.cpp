@@ -30,7 +30,8 @@ class StepTo : public TrajectoryGenerator {
 
 TEST(HardwareManipulator, PumaBehindAHardwareServerHoldsMovesAndShutsDownWhenTheServerDies) {
   const std::string name = "test-arm-" + std::to_string(::getpid());
-  test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560"});
+  // -watchdog 5000: a servo loop stalled by a loaded test machine is not cut off by the server.
+  test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
   ASSERT_TRUE(server.readLine(10000).has_value()) << "the server did not start";
   RoboticPlatform::setConfiguration(Configuration::parse(
       "[leader]\nclass Puma560\nsimulationMode off\nhwserver " + name + "\n", "rp.cfg"));

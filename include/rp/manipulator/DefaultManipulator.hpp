@@ -172,7 +172,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void finishCycle(double t, double dt);
   void holdUntilSafe();
   void publish();
-  bool readHardware();
+  bool readHardware(double elapsed);
   void writeHardware();
   void writeOutputsOff() noexcept;
   void ioFailure(const char* what, int line);

@@ -43,6 +43,19 @@ class Differentiator {
     if (filter_) return filter_->filter(derivative_);
     return derivative_;
   }
+  /// Takes the next sample `x`, taken `elapsed` seconds after the previous one instead of one
+  /// sample period (a late sample, e.g. after a stalled cycle), and returns the derivative
+  /// estimate: the difference is divided by the time that really passed, so a late sample is no
+  /// spike. Real-time safe: yes for scalars and fixed-size types.
+  /// @param[in] x        the sample
+  /// @param[in] elapsed  time since the previous sample [s], > 0 (else the sample period is used)
+  const T& differentiate(const T& x, double elapsed) {
+    if (!(elapsed > 0) || !std::isfinite(elapsed) || !started_) return differentiate(x);
+    derivative_ = (x - previous_) / elapsed;
+    previous_ = x;
+    if (filter_) return filter_->filter(derivative_);
+    return derivative_;
+  }
   /// Forgets all earlier samples. Real-time safe: yes.
   void reset() {
     started_ = false;
