@@ -101,11 +101,55 @@ describe('Scene Viewer on work_cell', () => {
     await kp.dispatchEvent('change');
     await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'puma').panel.fields
       .find((f) => f.name === 'kp').value[2] === 1234.5);
-    // Out of range: refused with a message, the value shown again.
-    await kp.fill('-1');
+    // Invalid input is refused in the page, with the error next to the field, and nothing is
+    // sent (an empty box used to send 0 to the running arm).
+    await ctx.page.evaluate(() => {
+      window.sentSetParameter = [];
+      const ws = window.rp.conn.ws;
+      const send = ws.send.bind(ws);
+      ws.send = (text) => {
+        if (JSON.parse(text).type === 'setParameter') window.sentSetParameter.push(text);
+        send(text);
+      };
+    });
+    const error = panel.locator('.field-error[data-error="kp"]');
+    for (const [typed, why] of [['', /kp\[3\]: enter a number; not sent/], ['NaN', /'NaN' is not a number/],
+      ['1e999', /1e999 is too large/], ['-', /'-' is not a number/], ['-1', /-1 is outside \[0, /],
+      ['12abc', /'12abc' is not a number/], ['Infinity', /'Infinity' is not a number/]]) {
+      await kp.fill(typed);
+      await kp.dispatchEvent('change');
+      await error.waitFor({ state: 'visible' });
+      assert.match(await error.textContent(), why);
+    }
+    assert.deepEqual(await ctx.page.evaluate(() => window.sentSetParameter), []);
+    assert.equal(await ctx.page.evaluate(() => window.rp.scene.objects.find((o) => o.name === 'puma').panel.fields
+      .find((f) => f.name === 'kp').value[2]), 1234.5);
+    // A valid value is sent and taken, and the error goes away.
+    await kp.fill('1200');
     await kp.dispatchEvent('change');
-    await ctx.page.waitForSelector('#messages:not(.hidden)');
-    assert.match(await ctx.page.textContent('#messages'), /kp/);
+    await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'puma').panel.fields
+      .find((f) => f.name === 'kp').value[2] === 1200);
+    await error.waitFor({ state: 'hidden' });
+    // The server refuses what the page would not send (another client): the reply names the field.
+    const refused = await ctx.page.evaluate(async () => {
+      const out = [];
+      for (const value of [null, 'x', -1, 1e300]) {
+        try {
+          await window.rp.conn.request({ type: 'setParameter', object: 'puma', name: 'kp', value, index: 2 });
+          out.push('taken');
+        } catch (e) { out.push(e.message); }
+      }
+      try {
+        await window.rp.conn.request({ type: 'setParameter', object: 'puma', name: 'kp', values: [1, 2] });
+        out.push('taken');
+      } catch (e) { out.push(e.message); }
+      return out;
+    });
+    assert.match(refused[0], /'value' must be a number/);
+    assert.match(refused[1], /'value' must be a number/);
+    assert.match(refused[2], /'kp' = -1.* is outside/);
+    assert.match(refused[3], /'kp' = .* is outside/);
+    assert.match(refused[4], /'kp' needs 6 values, got 2/);
   });
 
   it('two pages at once both receive state', async () => {
