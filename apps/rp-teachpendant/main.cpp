@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <iostream>
 #include <memory>
 #include <mutex>
@@ -31,10 +32,17 @@ using nlohmann::json;
 class Teachpendant : public rp::RoboticObject {
  public:
   Teachpendant(const std::string& name, rp::Manipulator& arm) : rp::RoboticObject(name), arm_(arm) {
+    pushWatch_ = std::thread([this] { watchPush(); });
     publishObject();  // complete: the Scene Viewer may send it messages
   }
   ~Teachpendant() override {
     withdrawObject();  // first: waits for a message being handled; no new ones reach it
+    {
+      std::lock_guard<std::mutex> lock(pushMutex_);
+      quit_ = true;
+    }
+    pushCv_.notify_all();
+    pushWatch_.join();
     abort_ = true;
     if (job_.joinable()) job_.join();
     generator_.reset();
@@ -63,7 +71,13 @@ class Teachpendant : public rp::RoboticObject {
           throw std::invalid_argument("push: each force component must be a number within +-" + std::to_string(kMaxForce) + " N");
         wrench(i) = f.get<double>();
       }
+      // The force holds for kPushLapse only: the page repeats it every 50 ms while the pointer
+      // drags; a page that stops (closed, hidden, frozen, disconnected) lets it lapse.
+      std::lock_guard<std::mutex> lock(pushMutex_);
+      pushing_ = !wrench.isZero();
+      pushDeadline_ = std::chrono::steady_clock::now() + kPushLapse;
       arm_.applyExternalWrench(wrench);
+      pushCv_.notify_all();
     } else if (type == "store") {
       std::lock_guard<std::mutex> lock(mutex_);
       if (positions_.size() >= 1000) throw std::invalid_argument("the list is full (1000 positions)");
@@ -119,6 +133,22 @@ class Teachpendant : public rp::RoboticObject {
     rp::JointVector q;
   };
   static constexpr double kMaxForce = 500;  // [N]
+  static constexpr std::chrono::milliseconds kPushLapse{250};  // a push not repeated within this ends
+
+  // Thread: zeroes the push force once it has not been repeated for kPushLapse.
+  void watchPush() {
+    std::unique_lock<std::mutex> lock(pushMutex_);
+    while (!quit_) {
+      if (!pushing_) {
+        pushCv_.wait(lock);
+      } else if (pushCv_.wait_until(lock, pushDeadline_) == std::cv_status::timeout && pushing_ &&
+                 std::chrono::steady_clock::now() >= pushDeadline_) {
+        arm_.clearExternalWrench();
+        pushing_ = false;
+        ++pushesLapsed_;
+      }
+    }
+  }
 
   bool busy() const { return running_.load(); }
 
@@ -139,7 +169,15 @@ class Teachpendant : public rp::RoboticObject {
       for (Eigen::Index i = 0; i < p.q.size(); ++i) q.push_back(p.q(i));
       list.push_back({{"name", p.name}, {"q", q}});
     }
+    bool pushing = false;
+    int lapsed = 0;
+    {
+      std::lock_guard<std::mutex> pushLock(pushMutex_);
+      pushing = pushing_;
+      lapsed = pushesLapsed_;
+    }
     return {{"zeroGravity", arm_.isZeroGravityModeOn()}, {"simulation", arm_.isSimulationModeOn()},
+            {"pushing", pushing}, {"pushesLapsed", lapsed},
             {"busy", running_.load()}, {"target", target_}, {"positions", list}};
   }
 
@@ -155,7 +193,11 @@ class Teachpendant : public rp::RoboticObject {
         for (std::size_t i : which) targets.push_back(positions_[i]);
     }
     abort_ = false;
-    arm_.clearExternalWrench();
+    {
+      std::lock_guard<std::mutex> lock(pushMutex_);
+      pushing_ = false;
+      arm_.clearExternalWrench();
+    }
     arm_.setZeroGravityModeOff();
     generator_.reset();
     generator_ = std::make_unique<rp::DefaultTrajectoryGenerator<>>();
@@ -190,6 +232,13 @@ class Teachpendant : public rp::RoboticObject {
   std::unique_ptr<rp::DefaultTrajectoryGenerator<>> generator_;
   std::thread job_;
   std::atomic<bool> running_{false}, abort_{false};
+  // The push force's deadline (watchPush()).
+  mutable std::mutex pushMutex_;
+  std::condition_variable pushCv_;
+  bool pushing_ = false, quit_ = false;
+  int pushesLapsed_ = 0;
+  std::chrono::steady_clock::time_point pushDeadline_{};
+  std::thread pushWatch_;
 };
 
 const char* kUsage =

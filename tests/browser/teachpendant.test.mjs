@@ -76,4 +76,28 @@ describe('rp-teachpendant', () => {
     assert.match(bad[2], /'times' must be 1 to 100/);
     assert.match(bad[3], /true or false/);
   });
+
+  it('a push force lapses when the page stops repeating it', async () => {
+    // One push, as from a page closed in the middle of a drag: the program zeroes the force
+    // once it has not been repeated for 250 ms (the page repeats it every 50 ms).
+    const reply = await ctx.page.evaluate(() =>
+      window.rp.conn.message('teachpendant', 'push', JSON.stringify({ force: [40, 0, 0] })).then((r) => JSON.parse(r.reply)));
+    assert.equal(reply.pushing, true);
+    const read = () => ctx.page.evaluate(() =>
+      window.rp.conn.message('teachpendant', 'read', '').then((r) => JSON.parse(r.reply)));
+    const deadline = Date.now() + 20000;
+    let now = await read();
+    while (now.pushing && Date.now() < deadline) now = await read();
+    assert.equal(now.pushing, false);
+    assert.equal(now.pushesLapsed, reply.pushesLapsed + 1);
+    // A push repeated holds, and a zero force ends it.
+    for (let i = 0; i < 5; ++i) {
+      const r = await ctx.page.evaluate(() => window.rp.conn.message('teachpendant', 'push', JSON.stringify({ force: [5, 0, 0] }))
+        .then((x) => JSON.parse(x.reply)));
+      assert.equal(r.pushing, true);
+    }
+    const end = await ctx.page.evaluate(() => window.rp.conn.message('teachpendant', 'push', JSON.stringify({ force: [0, 0, 0] }))
+      .then((x) => JSON.parse(x.reply)));
+    assert.equal(end.pushing, false);
+  });
 });
