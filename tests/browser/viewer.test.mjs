@@ -82,6 +82,42 @@ describe('Scene Viewer on work_cell', () => {
     await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'puma').display === 'solid');
   });
 
+  it('picking: parts not drawn are not picked, and a right drag (pan) opens no menu', async () => {
+    // The work piece with the arm out of the way, then with its own parts hidden (as a hidden
+    // link is): what is not drawn is not picked.
+    const picks = await ctx.page.evaluate(() => {
+      const v = window.rp.view;
+      const puma = v.objects.get('puma').root;
+      const piece = v.objects.get('workpiece').root;
+      puma.visible = false;
+      const p = v.screenPosition('workpiece');
+      const shown = v.pick(p.x, p.y);
+      const saved = [];
+      piece.traverse((c) => { if (c !== piece) { saved.push([c, c.visible]); c.visible = false; } });
+      const hiddenParts = v.pick(p.x, p.y);
+      for (const [c, vis] of saved) c.visible = vis;
+      puma.visible = true;
+      return { shown, hiddenParts };
+    });
+    assert.equal(picks.shown, 'workpiece');
+    assert.notEqual(picks.hiddenParts, 'workpiece');
+    // A right drag starting on the work piece pans the view; no menu opens.
+    const pos = await ctx.page.evaluate(() => window.rp.view.screenPosition('workpiece'));
+    const target0 = await ctx.page.evaluate(() => window.rp.view.controls.target.toArray());
+    await ctx.page.mouse.move(pos.x, pos.y);
+    await ctx.page.mouse.down({ button: 'right' });
+    await ctx.page.mouse.move(pos.x + 60, pos.y + 30, { steps: 6 });
+    await ctx.page.mouse.up({ button: 'right' });
+    assert.equal(await ctx.page.evaluate(() => document.getElementById('popup-menu').classList.contains('hidden')), true,
+      'a right drag opened the pop-up menu');
+    assert.notDeepEqual(await ctx.page.evaluate(() => window.rp.view.controls.target.toArray()), target0, 'the view did not pan');
+    // A right click where the button is released opens it.
+    const now = await ctx.page.evaluate(() => window.rp.view.screenPosition('gripper'));
+    await ctx.page.mouse.click(now.x, now.y, { button: 'right' });
+    await ctx.page.waitForSelector('#popup-menu:not(.hidden)');
+    await ctx.page.keyboard.press('Escape');
+  });
+
   it('control panel of the Puma: live joint state, and a tuned gain reaches the servo loop', async () => {
     await ctx.page.click('#object-table tr[data-object="puma"]', { button: 'right' });
     await ctx.page.click('#popup-menu .item[data-action="Control Panel..."]');
