@@ -661,17 +661,23 @@ void SceneViewer::Impl::tick() {
 }
 
 // Once a system shutdown has been requested, tells every page (and every page that connects
-// later) why, which object reported an error, and when: {"type": "shutdown", "reason",
+// later) why, which objects reported an error (as last described), and when: {"type": "shutdown", "reason",
 // "objects": [{"name", "code", "message"}], "time" (UTC, ISO 8601)}.
 void SceneViewer::Impl::announceShutdown() {
   if (!shutdownMessage.empty() || !ObjectManager::isShutdownRequested()) return;
   const std::string reason = ObjectManager::getShutdownReason();
   if (reason.empty()) return;  // being written by the requesting thread: next tick
+  // The objects' errors as last described: asking the objects now would wait for the registry,
+  // which the shutdown holds while it shuts them down, and the pages would hear of it only then.
   json objects = json::array();
-  for (const ObjectReference& o : ObjectManager().getPublishedObjects()) {
-    const ErrorStatus e = o->getErrorStatus();
-    if (e.code != 0) objects.push_back({{"name", o->getName()}, {"code", e.code}, {"message", e.message}});
-  }
+  const json described = json::parse(scene.sceneMessage(), nullptr, false);
+  if (described.is_object() && described.contains("objects"))
+    for (const json& o : described["objects"]) {
+      const json error = o.value("error", json::object());
+      if (error.value("code", 0) != 0)
+        objects.push_back({{"name", o.value("name", "")}, {"code", error.value("code", 0)},
+                           {"message", error.value("message", "")}});
+    }
   const auto now = std::chrono::system_clock::now();
   const std::time_t t = std::chrono::system_clock::to_time_t(now);
   const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
