@@ -7,6 +7,8 @@
 // selected positions. Runs until Ctrl-C (SIGINT) or SIGTERM.
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -27,6 +29,63 @@ namespace {
 
 using nlohmann::json;
 
+// Brings the arm to rest at once from the motion it is in (the Teachpendant's Stop): each
+// joint's setpoint velocity falls to zero at 80 % of the model's acceleration limit, the share the
+// pendant's motions are planned with, so the arm stops no further than the motion it interrupts
+// would have taken it (that motion ends at a stored position, inside the limits). The servo
+// thread calls it: no allocation, no lock.
+class Brake : public rp::TrajectoryGenerator {
+ public:
+  // velocity: the joints' velocity when the brake takes over [rad/s]
+  Brake(const rp::ManipulatorModel& model, const rp::JointVector& velocity)
+      : rp::TrajectoryGenerator("teachpendant.brake"), n_(model.getNumberOfJoints()) {
+    for (int i = 0; i < n_; ++i) {
+      a_[static_cast<std::size_t>(i)] = 0.8 * model.getAccelerationLimit()(i);
+      v_[static_cast<std::size_t>(i)] = velocity(i);
+    }
+    publishObject();
+  }
+  ~Brake() override {
+    withdrawObject();
+    releaseFromManipulators();
+  }
+  void attach(rp::Manipulator& manipulator) override {
+    if (manipulator.getNumberOfJoints() != n_) throw std::invalid_argument("Brake: wrong number of joints");
+    started_ = false;
+  }
+  bool getCurrentSetpoint(double time, rp::Setpoint& setpoint) override {
+    if (!started_) {  // from the last setpoint (the position the motion had reached)
+      for (int i = 0; i < n_; ++i) p_[static_cast<std::size_t>(i)] = setpoint.position(i);
+      lastTime_ = time;
+      started_ = true;
+    }
+    const double dt = std::clamp(time - lastTime_, 0.0, 0.1);
+    lastTime_ = time;
+    for (int i = 0; i < n_; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      double a = 0;
+      if (std::abs(v_[k]) <= a_[k] * dt) {
+        p_[k] += 0.5 * v_[k] * dt;
+        v_[k] = 0;
+      } else {
+        a = -std::copysign(a_[k], v_[k]);
+        p_[k] += (v_[k] + 0.5 * a * dt) * dt;
+        v_[k] += a * dt;
+      }
+      setpoint.position(i) = p_[k];
+      setpoint.velocity(i) = v_[k];
+      setpoint.acceleration(i) = a;
+    }
+    return true;
+  }
+
+ private:
+  int n_;
+  std::array<double, rp::kMaxJoints> a_{}, v_{}, p_{};  // (servo thread once attached)
+  double lastTime_ = 0;
+  bool started_ = false;
+};
+
 // The Teachpendant's state and commands; the GUI reaches it with `message` requests (they run in
 // the viewer's worker thread, one at a time). Motions run in a thread of their own.
 class Teachpendant : public rp::RoboticObject {
@@ -46,6 +105,7 @@ class Teachpendant : public rp::RoboticObject {
     abort_ = true;
     if (job_.joinable()) job_.join();
     generator_.reset();
+    brake_.reset();
     arm_.clearExternalWrench();
   }
 
@@ -119,7 +179,14 @@ class Teachpendant : public rp::RoboticObject {
       }
       start(which, times);
     } else if (type == "stop") {
+      // Stops at once: no further position, and the motion under way is braked now (its
+      // generator, disconnected from the arm, ends its waits).
       abort_ = true;
+      if (busy()) {
+        auto brake = std::make_unique<Brake>(arm_.getModel(), arm_.getJointVelocity());
+        arm_.setTrajectoryGenerator(*brake);
+        brake_ = std::move(brake);  // the previous brake, if any, after the arm left it
+      }
     } else {
       return rp::RoboticObject::handleMessage(type, payload, reply);
     }
@@ -230,6 +297,7 @@ class Teachpendant : public rp::RoboticObject {
   int stored_ = 0;
   std::string target_;
   std::unique_ptr<rp::DefaultTrajectoryGenerator<>> generator_;
+  std::unique_ptr<Brake> brake_;  // the last Stop's brake (the arm may still use it)
   std::thread job_;
   std::atomic<bool> running_{false}, abort_{false};
   // The push force's deadline (watchPush()).
