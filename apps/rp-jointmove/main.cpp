@@ -29,6 +29,10 @@ namespace {
 using rp::JointVector;
 using rp::kMaxJoints;
 
+// The margin inside a joint's limits [lo, hi] that targets keep: 5 % of the range, at most 5
+// degrees (the Joint Move page's sliders end there too, see web/src/jointmove.js).
+double limitMargin(double lo, double hi) { return std::min(0.05 * (hi - lo), 5 * M_PI / 180); }
+
 // Follows joint targets set from any thread (lock-free atomics) with a velocity- and
 // acceleration-limited setpoint: the arm moves as soon as a slider moves.
 class JointFollower : public rp::TrajectoryGenerator {
@@ -36,8 +40,12 @@ class JointFollower : public rp::TrajectoryGenerator {
   JointFollower(const std::string& name, const rp::ManipulatorModel& model, const JointVector& start)
       : rp::TrajectoryGenerator(name), n_(model.getNumberOfJoints()) {
     for (int i = 0; i < n_; ++i) {
-      qmin_[i] = model.getPositionMin()(i);
-      qmax_[i] = model.getPositionMax()(i);
+      // Targets stay a margin inside the joint limits: the arm lags its setpoint and would
+      // overshoot a target on the limit, which shuts the system down.
+      const double lo = model.getPositionMin()(i), hi = model.getPositionMax()(i);
+      const double margin = limitMargin(lo, hi);
+      qmin_[i] = lo + margin;
+      qmax_[i] = hi - margin;
       vmax_[i] = 0.5 * model.getVelocityLimit()(i);
       amax_[i] = 0.5 * model.getAccelerationLimit()(i);
       target_[i].store(start(i));
@@ -119,7 +127,8 @@ class JointFollower : public rp::TrajectoryGenerator {
       if (i < 0 || i >= n_) throw std::invalid_argument("joint " + std::to_string(i) + " out of range 0.." + std::to_string(n_ - 1));
       if (!std::isfinite(v) || v < qmin_[i] || v > qmax_[i])
         throw std::invalid_argument("joint " + std::to_string(i + 1) + ": " + std::to_string(v) + " rad is outside [" +
-                                    std::to_string(qmin_[i]) + ", " + std::to_string(qmax_[i]) + "]");
+                                    std::to_string(qmin_[i]) + ", " + std::to_string(qmax_[i]) +
+                                    "] (the joint limits less a margin)");
     }
     for (const auto& [i, v] : set) target_[i].store(v, std::memory_order_relaxed);
     reply.clear();

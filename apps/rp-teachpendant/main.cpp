@@ -7,9 +7,12 @@
 // selected positions. Runs until Ctrl-C (SIGINT) or SIGTERM.
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <iostream>
 #include <memory>
 #include <mutex>
@@ -26,18 +29,83 @@ namespace {
 
 using nlohmann::json;
 
+// Brings the arm to rest at once from the motion it is in (the Teachpendant's Stop): each
+// joint's setpoint velocity falls to zero at 80 % of the model's acceleration limit, the share the
+// pendant's motions are planned with, so the arm stops no further than the motion it interrupts
+// would have taken it (that motion ends at a stored position, inside the limits). The servo
+// thread calls it: no allocation, no lock.
+class Brake : public rp::TrajectoryGenerator {
+ public:
+  // velocity: the joints' velocity when the brake takes over [rad/s]
+  Brake(const rp::ManipulatorModel& model, const rp::JointVector& velocity)
+      : rp::TrajectoryGenerator("teachpendant.brake"), n_(model.getNumberOfJoints()) {
+    for (int i = 0; i < n_; ++i) {
+      a_[static_cast<std::size_t>(i)] = 0.8 * model.getAccelerationLimit()(i);
+      v_[static_cast<std::size_t>(i)] = velocity(i);
+    }
+    publishObject();
+  }
+  ~Brake() override {
+    withdrawObject();
+    releaseFromManipulators();
+  }
+  void attach(rp::Manipulator& manipulator) override {
+    if (manipulator.getNumberOfJoints() != n_) throw std::invalid_argument("Brake: wrong number of joints");
+    started_ = false;
+  }
+  bool getCurrentSetpoint(double time, rp::Setpoint& setpoint) override {
+    if (!started_) {  // from the last setpoint (the position the motion had reached)
+      for (int i = 0; i < n_; ++i) p_[static_cast<std::size_t>(i)] = setpoint.position(i);
+      lastTime_ = time;
+      started_ = true;
+    }
+    const double dt = std::clamp(time - lastTime_, 0.0, 0.1);
+    lastTime_ = time;
+    for (int i = 0; i < n_; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      double a = 0;
+      if (std::abs(v_[k]) <= a_[k] * dt) {
+        p_[k] += 0.5 * v_[k] * dt;
+        v_[k] = 0;
+      } else {
+        a = -std::copysign(a_[k], v_[k]);
+        p_[k] += (v_[k] + 0.5 * a * dt) * dt;
+        v_[k] += a * dt;
+      }
+      setpoint.position(i) = p_[k];
+      setpoint.velocity(i) = v_[k];
+      setpoint.acceleration(i) = a;
+    }
+    return true;
+  }
+
+ private:
+  int n_;
+  std::array<double, rp::kMaxJoints> a_{}, v_{}, p_{};  // (servo thread once attached)
+  double lastTime_ = 0;
+  bool started_ = false;
+};
+
 // The Teachpendant's state and commands; the GUI reaches it with `message` requests (they run in
 // the viewer's worker thread, one at a time). Motions run in a thread of their own.
 class Teachpendant : public rp::RoboticObject {
  public:
   Teachpendant(const std::string& name, rp::Manipulator& arm) : rp::RoboticObject(name), arm_(arm) {
+    pushWatch_ = std::thread([this] { watchPush(); });
     publishObject();  // complete: the Scene Viewer may send it messages
   }
   ~Teachpendant() override {
     withdrawObject();  // first: waits for a message being handled; no new ones reach it
+    {
+      std::lock_guard<std::mutex> lock(pushMutex_);
+      quit_ = true;
+    }
+    pushCv_.notify_all();
+    pushWatch_.join();
     abort_ = true;
     if (job_.joinable()) job_.join();
     generator_.reset();
+    brake_.reset();
     arm_.clearExternalWrench();
   }
 
@@ -63,7 +131,13 @@ class Teachpendant : public rp::RoboticObject {
           throw std::invalid_argument("push: each force component must be a number within +-" + std::to_string(kMaxForce) + " N");
         wrench(i) = f.get<double>();
       }
+      // The force holds for kPushLapse only: the page repeats it every 50 ms while the pointer
+      // drags; a page that stops (closed, hidden, frozen, disconnected) lets it lapse.
+      std::lock_guard<std::mutex> lock(pushMutex_);
+      pushing_ = !wrench.isZero();
+      pushDeadline_ = std::chrono::steady_clock::now() + kPushLapse;
       arm_.applyExternalWrench(wrench);
+      pushCv_.notify_all();
     } else if (type == "store") {
       std::lock_guard<std::mutex> lock(mutex_);
       if (positions_.size() >= 1000) throw std::invalid_argument("the list is full (1000 positions)");
@@ -105,7 +179,14 @@ class Teachpendant : public rp::RoboticObject {
       }
       start(which, times);
     } else if (type == "stop") {
+      // Stops at once: no further position, and the motion under way is braked now (its
+      // generator, disconnected from the arm, ends its waits).
       abort_ = true;
+      if (busy()) {
+        auto brake = std::make_unique<Brake>(arm_.getModel(), arm_.getJointVelocity());
+        arm_.setTrajectoryGenerator(*brake);
+        brake_ = std::move(brake);  // the previous brake, if any, after the arm left it
+      }
     } else {
       return rp::RoboticObject::handleMessage(type, payload, reply);
     }
@@ -119,6 +200,22 @@ class Teachpendant : public rp::RoboticObject {
     rp::JointVector q;
   };
   static constexpr double kMaxForce = 500;  // [N]
+  static constexpr std::chrono::milliseconds kPushLapse{250};  // a push not repeated within this ends
+
+  // Thread: zeroes the push force once it has not been repeated for kPushLapse.
+  void watchPush() {
+    std::unique_lock<std::mutex> lock(pushMutex_);
+    while (!quit_) {
+      if (!pushing_) {
+        pushCv_.wait(lock);
+      } else if (pushCv_.wait_until(lock, pushDeadline_) == std::cv_status::timeout && pushing_ &&
+                 std::chrono::steady_clock::now() >= pushDeadline_) {
+        arm_.clearExternalWrench();
+        pushing_ = false;
+        ++pushesLapsed_;
+      }
+    }
+  }
 
   bool busy() const { return running_.load(); }
 
@@ -139,7 +236,15 @@ class Teachpendant : public rp::RoboticObject {
       for (Eigen::Index i = 0; i < p.q.size(); ++i) q.push_back(p.q(i));
       list.push_back({{"name", p.name}, {"q", q}});
     }
+    bool pushing = false;
+    int lapsed = 0;
+    {
+      std::lock_guard<std::mutex> pushLock(pushMutex_);
+      pushing = pushing_;
+      lapsed = pushesLapsed_;
+    }
     return {{"zeroGravity", arm_.isZeroGravityModeOn()}, {"simulation", arm_.isSimulationModeOn()},
+            {"pushing", pushing}, {"pushesLapsed", lapsed},
             {"busy", running_.load()}, {"target", target_}, {"positions", list}};
   }
 
@@ -155,7 +260,11 @@ class Teachpendant : public rp::RoboticObject {
         for (std::size_t i : which) targets.push_back(positions_[i]);
     }
     abort_ = false;
-    arm_.clearExternalWrench();
+    {
+      std::lock_guard<std::mutex> lock(pushMutex_);
+      pushing_ = false;
+      arm_.clearExternalWrench();
+    }
     arm_.setZeroGravityModeOff();
     generator_.reset();
     generator_ = std::make_unique<rp::DefaultTrajectoryGenerator<>>();
@@ -188,8 +297,16 @@ class Teachpendant : public rp::RoboticObject {
   int stored_ = 0;
   std::string target_;
   std::unique_ptr<rp::DefaultTrajectoryGenerator<>> generator_;
+  std::unique_ptr<Brake> brake_;  // the last Stop's brake (the arm may still use it)
   std::thread job_;
   std::atomic<bool> running_{false}, abort_{false};
+  // The push force's deadline (watchPush()).
+  mutable std::mutex pushMutex_;
+  std::condition_variable pushCv_;
+  bool pushing_ = false, quit_ = false;
+  int pushesLapsed_ = 0;
+  std::chrono::steady_clock::time_point pushDeadline_{};
+  std::thread pushWatch_;
 };
 
 const char* kUsage =

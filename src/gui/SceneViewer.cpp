@@ -15,17 +15,20 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cctype>
+#include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <deque>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <list>
 #include <mutex>
 #include <random>
 #include <set>
-#include <sstream>
 #include <thread>
 
 #include "SceneState.hpp"
@@ -60,6 +63,7 @@ constexpr std::size_t kMaxStringField = 256;         // longest name, command or
 constexpr std::size_t kMaxLogColumns = 32;           // log columns one page may plot
 constexpr std::size_t kMaxLogBatch = 2000;           // samples per column in one batch
 constexpr int kPortFallbacks = 20;
+constexpr auto kMaxAcceptPause = std::chrono::seconds(1);  // longest pause after an accept error
 
 std::string& startPageStorage() {
   static std::string* page = new std::string("index.html");
@@ -114,6 +118,86 @@ std::string mimeType(const std::string& path) {
   return "application/octet-stream";
 }
 
+constexpr std::uintmax_t kMaxFrontEndFileBytes = 16u << 20;  // largest front-end file served
+constexpr std::uintmax_t kMaxMeshFileBytes = 64u << 20;      // largest mesh file served
+constexpr std::size_t kMaxFrontEndPath = 256;                // longest front-end URL path
+
+// Whether `path` (a request target without its query) has the shape of a front-end file's URL:
+// '/' and then segments of letters, digits, '.', '_' and '-', none empty and none starting with
+// '.'. This refuses "//etc/passwd" (an empty segment: the rest would be an absolute path), "..",
+// hidden files, percent-encoding (no front-end file needs it, so nothing is decoded) and
+// backslashes before the file system is asked anything.
+bool isFrontEndPath(std::string_view path) {
+  if (path.size() < 2 || path.size() > kMaxFrontEndPath || path[0] != '/') return false;
+  for (std::size_t start = 1; start <= path.size();) {
+    std::size_t end = path.find('/', start);
+    if (end == std::string_view::npos) end = path.size();
+    const std::string_view segment = path.substr(start, end - start);
+    if (segment.empty() || segment[0] == '.') return false;
+    for (char c : segment) {
+      const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+                      c == '_' || c == '-';
+      if (!ok) return false;
+    }
+    start = end + 1;
+  }
+  return true;
+}
+
+// The file of the front end that the URL path names: the path resolved (symbolic links followed)
+// must still lie inside the resolved web root and be a regular file of at most
+// kMaxFrontEndFileBytes. Empty if there is none.
+std::filesystem::path frontEndFile(const std::string& webRoot, std::string_view path) {
+  namespace fs = std::filesystem;
+  if (webRoot.empty() || !isFrontEndPath(path)) return {};
+  std::error_code ec;
+  const fs::path root = fs::canonical(webRoot, ec);
+  if (ec) return {};
+  const fs::path file = fs::canonical(root / fs::path(std::string(path.substr(1))), ec);
+  if (ec) return {};
+  auto r = root.begin(), f = file.begin();
+  for (; r != root.end(); ++r, ++f)
+    if (f == file.end() || *r != *f) return {};  // outside the web root (a link out of it)
+  if (f == file.end()) return {};                // the root itself
+  if (!fs::is_regular_file(file, ec) || fs::file_size(file, ec) > kMaxFrontEndFileBytes || ec) return {};
+  return file;
+}
+
+// The contents of `file`, at most `limit` bytes; false if it cannot be read whole within the limit.
+bool readFileCapped(const std::filesystem::path& file, std::uintmax_t limit, std::string& out) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;
+  out.clear();
+  char chunk[64 * 1024];
+  while (in) {
+    in.read(chunk, sizeof chunk);
+    out.append(chunk, static_cast<std::size_t>(in.gcount()));
+    if (out.size() > limit) return false;  // grew since its size was checked
+  }
+  return in.eof();
+}
+
+// The host part of a Host header value: "name", "name:port", "[v6]" or "[v6]:port" -> name or
+// "[v6]", lower case; empty if it is malformed.
+std::string hostName(std::string_view host) {
+  std::string h;
+  if (!host.empty() && host[0] == '[') {
+    const auto close = host.find(']');
+    if (close == std::string_view::npos) return {};
+    h = std::string(host.substr(0, close + 1));
+    host = host.substr(close + 1);
+  } else {
+    const auto colon = host.find(':');
+    h = std::string(host.substr(0, colon));
+    host = colon == std::string_view::npos ? std::string_view() : host.substr(colon);
+  }
+  if (!host.empty() && (host[0] != ':' || host.size() < 2 || host.size() > 6 ||
+                        host.substr(1).find_first_not_of("0123456789") != std::string_view::npos))
+    return {};  // only ":port" may follow
+  std::transform(h.begin(), h.end(), h.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return h;
+}
+
 const char* kNotBuiltPage =
     "<!doctype html><html><head><meta charset=\"utf-8\"><title>Robotic Platform</title></head><body>"
     "<h1>Robotic Platform Scene Viewer</h1><p>The front end is not built. Build the CMake target "
@@ -126,25 +210,37 @@ const char* kNotBuiltPage =
 struct SceneViewer::Impl {
   class WsSession;
   class HttpSession;
+  class ConnectionSlot;
 
   mutable std::mutex mutex;  // guards the fields below that other threads read
   bool running = false;
   SceneViewerOptions options;
   std::string token;
+  std::set<std::string> hostNames;  // Host header names accepted (see hostAllowed())
+  bool anyIpHost = false;           // listening on every address: any IP literal is accepted too
   int port = 0;
   std::string url;
 
   std::unique_ptr<asio::io_context> ioc;
   std::unique_ptr<tcp::acceptor> acceptor;
   std::unique_ptr<asio::steady_timer> timer;
+  std::unique_ptr<asio::steady_timer> acceptTimer;  // the pause after an accept error
+  std::chrono::milliseconds acceptPause{0};
   std::thread thread;
+
+  // Connections (server thread): how many are open, and the HTTP connections waiting for a
+  // request, oldest first (closed first when a connection is needed).
+  std::size_t openConnections = 0;
+  std::list<std::weak_ptr<HttpSession>> idleHttp;
 
   // Server-thread state.
   std::set<std::shared_ptr<WsSession>> sessions;
   internal::SceneState scene;
   std::chrono::steady_clock::time_point lastRefresh{};
   std::chrono::steady_clock::duration period{};
+  std::chrono::steady_clock::duration writeTimeout{};
   std::chrono::steady_clock::time_point lastLogPush{};
+  std::string shutdownMessage;  // the system shutdown every page is told about (empty: none yet)
 
   // Worker thread for commands that touch objects (they may block, e.g. a serial device).
   std::thread worker;
@@ -156,9 +252,13 @@ struct SceneViewer::Impl {
   // Statistics.
   std::atomic<std::uint64_t> connections{0}, framesBuilt{0}, framesSent{0}, framesDropped{0}, messagesReceived{0},
       messagesRefused{0}, handshakesRefused{0};
-  std::atomic<std::size_t> pageCount{0};
+  std::atomic<std::size_t> pageCount{0}, openCount{0};
+  std::atomic<std::uint64_t> connectionsClosedForRoom{0}, connectionsRefused{0}, acceptFailures{0}, slowPagesDropped{0};
 
   void accept();
+  bool closeIdleConnection();
+  void announceShutdown();
+  bool hostAllowed(std::string_view host) const;
   void tick();
   bool refreshScene(bool force);
   void onMessage(const std::shared_ptr<WsSession>& session, std::string text, bool binary);
@@ -169,10 +269,29 @@ struct SceneViewer::Impl {
   void workerLoop();
 };
 
+// One of the kSceneViewerMaxConnections connections, counted while held (server thread).
+class SceneViewer::Impl::ConnectionSlot {
+ public:
+  explicit ConnectionSlot(Impl& impl) : impl_(&impl) { impl_->openCount.store(++impl_->openConnections); }
+  ConnectionSlot(ConnectionSlot&& other) noexcept : impl_(std::exchange(other.impl_, nullptr)) {}
+  ConnectionSlot(const ConnectionSlot&) = delete;
+  ConnectionSlot& operator=(const ConnectionSlot&) = delete;
+  ConnectionSlot& operator=(ConnectionSlot&&) = delete;
+  ~ConnectionSlot() { release(); }
+  void release() {
+    if (impl_) impl_->openCount.store(--impl_->openConnections);
+    impl_ = nullptr;
+  }
+
+ private:
+  Impl* impl_;
+};
+
 // A page's WebSocket: a bounded queue of text messages and a one-slot queue of the latest state frame.
 class SceneViewer::Impl::WsSession : public std::enable_shared_from_this<SceneViewer::Impl::WsSession> {
  public:
-  WsSession(Impl& impl, tcp::socket&& socket) : impl_(impl), ws_(std::move(socket)) {}
+  WsSession(Impl& impl, tcp::socket&& socket, ConnectionSlot&& slot)
+      : impl_(impl), slot_(std::move(slot)), ws_(std::move(socket)) {}
 
   void run(http::request<http::string_body> req) {
     ws_.read_message_max(kMaxMessageBytes);
@@ -187,6 +306,7 @@ class SceneViewer::Impl::WsSession : public std::enable_shared_from_this<SceneVi
                     {"qmotor", RoboticPlatform::isQMotorOn()},
                     {"rate", self->impl_.options.rate}};
       self->sendText(hello.dump());
+      if (!self->impl_.shutdownMessage.empty()) self->sendText(self->impl_.shutdownMessage);
       if (!self->impl_.refreshScene(true)) self->sendText(self->impl_.scene.sceneMessage());
       self->read();
     });
@@ -203,7 +323,7 @@ class SceneViewer::Impl::WsSession : public std::enable_shared_from_this<SceneVi
   }
 
   void sendState(const std::shared_ptr<const std::string>& frame) {
-    if (closed_) return;
+    if (closed_ || closing_) return;
     if (state_) impl_.framesDropped.fetch_add(1);
     state_ = frame;
     write();
@@ -224,6 +344,22 @@ class SceneViewer::Impl::WsSession : public std::enable_shared_from_this<SceneVi
     beast::error_code ec;
     beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ec);
     beast::get_lowest_layer(ws_).socket().close(ec);
+    slot_.release();
+  }
+
+  // Closes once the messages queued now are written (the server is stopping; its last word, such
+  // as the system shutdown, should reach the page). stop() closes what is left shortly after.
+  void closeWhenWritten() {
+    if (closed_) return;
+    closing_ = true;
+    state_.reset();
+    if (!writing_ && text_.empty()) close();
+  }
+
+  // Whether a write has waited longer than `timeout` for the page to read (a page that stopped
+  // reading: its socket's buffers are full).
+  bool writeStalled(std::chrono::steady_clock::time_point now, std::chrono::steady_clock::duration timeout) const {
+    return writing_ && now - writeStarted_ > timeout;
   }
 
  private:
@@ -255,38 +391,68 @@ class SceneViewer::Impl::WsSession : public std::enable_shared_from_this<SceneVi
       return;
     }
     writing_ = true;
+    writeStarted_ = std::chrono::steady_clock::now();
     ws_.binary(binary);
     ws_.async_write(asio::buffer(*next), [self = shared_from_this(), next, binary](beast::error_code ec, std::size_t) {
       self->writing_ = false;
       if (ec) return self->close();
       if (binary) self->impl_.framesSent.fetch_add(1);
+      if (self->closing_ && self->text_.empty()) return self->close();
       self->write();
     });
   }
 
   Impl& impl_;
+  ConnectionSlot slot_;
   websocket::stream<beast::tcp_stream> ws_;
   beast::flat_buffer buffer_;
   std::deque<std::shared_ptr<const std::string>> text_;
   std::shared_ptr<const std::string> state_;
   bool writing_ = false;
+  bool closing_ = false;
+  std::chrono::steady_clock::time_point writeStarted_{};
   bool closed_ = false;
 };
 
 // An HTTP connection: static files of the web root, or the upgrade to a page's WebSocket.
 class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<SceneViewer::Impl::HttpSession> {
  public:
-  HttpSession(Impl& impl, tcp::socket&& socket) : impl_(impl), stream_(std::move(socket)) {}
+  HttpSession(Impl& impl, tcp::socket&& socket) : impl_(impl), slot_(impl), stream_(std::move(socket)) {}
+  ~HttpSession() { leaveIdle(); }
+  HttpSession(const HttpSession&) = delete;
+  HttpSession& operator=(const HttpSession&) = delete;
 
   void run() { read(); }
 
+  // Closes the connection to make room for another (it waits for a request: nothing is lost but
+  // a keep-alive connection the browser opens again).
+  void closeForRoom() {
+    leaveIdle();
+    beast::error_code ec;
+    stream_.socket().shutdown(tcp::socket::shutdown_both, ec);
+    stream_.socket().close(ec);
+    slot_.release();
+  }
+
  private:
+  void enterIdle() {
+    leaveIdle();
+    idle_ = impl_.idleHttp.insert(impl_.idleHttp.end(), weak_from_this());
+    isIdle_ = true;
+  }
+  void leaveIdle() {
+    if (isIdle_) impl_.idleHttp.erase(idle_);
+    isIdle_ = false;
+  }
+
   void read() {
+    enterIdle();
     parser_.emplace();
     parser_->header_limit(8 * 1024);
     parser_->body_limit(8 * 1024);
     stream_.expires_after(std::chrono::seconds(30));
     http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      self->leaveIdle();
       if (ec) {
         beast::error_code ignored;
         self->stream_.socket().shutdown(tcp::socket::shutdown_both, ignored);
@@ -298,6 +464,14 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
 
   void handle(http::request<http::string_body> req) {
     const std::string target(req.target());
+    // DNS rebinding: a page of another site whose name was made to resolve to this address sends
+    // that name as Host. Only the names this server is known by are accepted.
+    const auto host = req[http::field::host];
+    if (!impl_.hostAllowed(std::string_view(host.data(), host.size()))) {
+      if (websocket::is_upgrade(req)) impl_.handshakesRefused.fetch_add(1);
+      return respond(http::status::forbidden, "text/plain",
+                     "Scene Viewer: this server is not known by the host name in the Host header\n", req);
+    }
     if (websocket::is_upgrade(req)) {
       std::string why;
       if (target.substr(0, target.find('?')) != "/ws") why = "no WebSocket at this path";
@@ -313,31 +487,26 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
         return respond(http::status::forbidden, "text/plain", "Scene Viewer: " + why + "\n", req);
       }
       stream_.expires_never();
-      std::make_shared<WsSession>(impl_, stream_.release_socket())->run(std::move(req));
+      std::make_shared<WsSession>(impl_, stream_.release_socket(), std::move(slot_))->run(std::move(req));
       return;
     }
     if (req.method() != http::verb::get && req.method() != http::verb::head)
       return respond(http::status::method_not_allowed, "text/plain", "only GET\n", req);
     std::string path = target.substr(0, target.find('?'));
     if (path == "/") path = "/index.html";
-    if (path.empty() || path[0] != '/' || path.find("..") != std::string::npos || path.find('\\') != std::string::npos ||
-        path.find('%') != std::string::npos || path.find('\0') != std::string::npos)
-      return respond(http::status::bad_request, "text/plain", "bad path\n", req);
     if (path == "/api/info") {
       json info = {{"protocol", kSceneViewerProtocolVersion}, {"tokenRequired", !impl_.token.empty()}};
       return respond(http::status::ok, "application/json", info.dump(), req);
     }
     if (path == "/mesh") return serveMesh(target, req);
-    const std::filesystem::path file = std::filesystem::path(impl_.options.webRoot) / path.substr(1);
-    std::ifstream in(file, std::ios::binary);
-    std::error_code ec;
-    if (!in || !std::filesystem::is_regular_file(file, ec)) {
+    // Only the files of the built front end: nothing else of the file system is reachable.
+    const std::filesystem::path file = frontEndFile(impl_.options.webRoot, path);
+    std::string body;
+    if (file.empty() || !readFileCapped(file, kMaxFrontEndFileBytes, body)) {
       if (path == "/index.html") return respond(http::status::ok, "text/html; charset=utf-8", kNotBuiltPage, req);
-      return respond(http::status::not_found, "text/plain", "not found: " + path + "\n", req);
+      return respond(http::status::not_found, "text/plain", "not found\n", req);
     }
-    std::ostringstream body;
-    body << in.rdbuf();
-    respond(http::status::ok, mimeType(path), body.str(), req);
+    respond(http::status::ok, mimeType(path), std::move(body), req);
   }
 
   // GET /mesh?object=NAME&shape=I[&token=T]: the mesh file that shape I of a live object's 3D model
@@ -352,12 +521,11 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
     index = static_cast<std::size_t>(std::stoul(shape));
     const std::string file = impl_.scene.meshFile(object, index);
     std::error_code ec;
-    if (file.empty() || !std::filesystem::is_regular_file(file, ec) || std::filesystem::file_size(file, ec) > (64u << 20))
+    std::string body;
+    if (file.empty() || !std::filesystem::is_regular_file(file, ec) ||
+        std::filesystem::file_size(file, ec) > kMaxMeshFileBytes || ec || !readFileCapped(file, kMaxMeshFileBytes, body))
       return respond(http::status::not_found, "text/plain", "no mesh file for that shape\n", req);
-    std::ifstream in(file, std::ios::binary);
-    std::ostringstream body;
-    body << in.rdbuf();
-    respond(http::status::ok, "application/octet-stream", body.str(), req);
+    respond(http::status::ok, "application/octet-stream", std::move(body), req);
   }
 
   void respond(http::status status, const std::string& type, std::string body,
@@ -367,6 +535,10 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
     res->set(http::field::content_type, type);
     res->set(http::field::cache_control, "no-cache");
     res->set("X-Content-Type-Options", "nosniff");
+    // No other site may frame the pages (clickjacking) or learn the token from a Referer.
+    res->set("X-Frame-Options", "DENY");
+    res->set("Content-Security-Policy", "frame-ancestors 'none'");
+    res->set("Referrer-Policy", "no-referrer");
     res->keep_alive(req.keep_alive());
     if (req.method() != http::verb::head) res->body() = std::move(body);
     res->prepare_payload();
@@ -381,17 +553,76 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
   }
 
   Impl& impl_;
+  ConnectionSlot slot_;
   beast::tcp_stream stream_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
+  std::list<std::weak_ptr<HttpSession>>::iterator idle_;
+  bool isIdle_ = false;
 };
 
+// Accepts connections, at most kSceneViewerMaxConnections at a time: a new one takes the place
+// of the HTTP connection that has waited longest for a request, or is closed at once if every
+// connection is busy or a page. An accept error (out of file descriptors: the connection stays
+// in the listen queue) also closes such a connection to free a descriptor and tries again;
+// with none to close it pauses (10 ms, doubling up to 1 s) instead of trying again at once,
+// which would spin: the listening socket stays readable while the connection waits.
 void SceneViewer::Impl::accept() {
   acceptor->async_accept([this](beast::error_code ec, tcp::socket socket) {
     if (ec == asio::error::operation_aborted) return;
-    if (!ec) std::make_shared<HttpSession>(*this, std::move(socket))->run();
+    if (ec) {
+      acceptFailures.fetch_add(1);
+      if (closeIdleConnection()) return accept();
+      acceptPause = std::min<std::chrono::milliseconds>(
+          std::max(acceptPause * 2, std::chrono::milliseconds(10)),
+          std::chrono::duration_cast<std::chrono::milliseconds>(kMaxAcceptPause));
+      acceptTimer->expires_after(acceptPause);
+      acceptTimer->async_wait([this](beast::error_code e) {
+        if (!e) accept();
+      });
+      return;
+    }
+    acceptPause = std::chrono::milliseconds(0);
+    if (openConnections >= kSceneViewerMaxConnections && !closeIdleConnection()) {
+      connectionsRefused.fetch_add(1);
+      beast::error_code ignored;
+      socket.close(ignored);
+    } else {
+      std::make_shared<HttpSession>(*this, std::move(socket))->run();
+    }
     accept();
   });
+}
+
+// Closes the HTTP connection that has waited longest for a request; false if there is none.
+bool SceneViewer::Impl::closeIdleConnection() {
+  while (!idleHttp.empty()) {
+    std::shared_ptr<HttpSession> oldest = idleHttp.front().lock();
+    if (!oldest) {
+      idleHttp.pop_front();
+      continue;
+    }
+    oldest->closeForRoom();  // leaves the list
+    connectionsClosedForRoom.fetch_add(1);
+    return true;
+  }
+  return false;
+}
+
+// Whether a request's Host header names this server: localhost, a loopback address, the address
+// it listens on; when it listens on every address also the machine's name and any IP literal (a
+// rebinding attack needs a DNS name). With or without a port (a forwarded port may differ).
+bool SceneViewer::Impl::hostAllowed(std::string_view host) const {
+  const std::string name = hostName(host);
+  if (name.empty()) return false;
+  if (hostNames.count(name)) return true;
+  std::string literal = name;
+  if (literal.size() > 2 && literal.front() == '[' && literal.back() == ']') literal = literal.substr(1, literal.size() - 2);
+  else if (literal.find(':') != std::string::npos) return false;  // a v6 literal must be in brackets
+  beast::error_code ec;
+  const auto a = asio::ip::make_address(literal, ec);
+  if (ec) return false;
+  return a.is_loopback() || anyIpHost;
 }
 
 bool SceneViewer::Impl::refreshScene(bool force) {
@@ -413,12 +644,51 @@ void SceneViewer::Impl::tick() {
     if (ec) return;
     tick();
   });
+  announceShutdown();
   if (sessions.empty()) return;  // nothing to do without pages: no cost to the program
+  // A page that stopped reading (its socket's buffers full for writeTimeout) is dropped.
+  const auto now = std::chrono::steady_clock::now();
+  for (const auto& s : std::vector<std::shared_ptr<WsSession>>(sessions.begin(), sessions.end()))
+    if (s->writeStalled(now, writeTimeout)) {
+      slowPagesDropped.fetch_add(1);
+      s->close();
+    }
   refreshScene(false);
   pushLogSamples();
   auto frame = std::make_shared<const std::string>(scene.buildFrame());
   framesBuilt.fetch_add(1);
   for (const auto& s : std::vector<std::shared_ptr<WsSession>>(sessions.begin(), sessions.end())) s->sendState(frame);
+}
+
+// Once a system shutdown has been requested, tells every page (and every page that connects
+// later) why, which objects reported an error (as last described), and when: {"type": "shutdown", "reason",
+// "objects": [{"name", "code", "message"}], "time" (UTC, ISO 8601)}.
+void SceneViewer::Impl::announceShutdown() {
+  if (!shutdownMessage.empty() || !ObjectManager::isShutdownRequested()) return;
+  const std::string reason = ObjectManager::getShutdownReason();
+  if (reason.empty()) return;  // being written by the requesting thread: next tick
+  // The objects' errors as last described: asking the objects now would wait for the registry,
+  // which the shutdown holds while it shuts them down, and the pages would hear of it only then.
+  json objects = json::array();
+  const json described = json::parse(scene.sceneMessage(), nullptr, false);
+  if (described.is_object() && described.contains("objects"))
+    for (const json& o : described["objects"]) {
+      const json error = o.value("error", json::object());
+      if (error.value("code", 0) != 0)
+        objects.push_back({{"name", o.value("name", "")}, {"code", error.value("code", 0)},
+                           {"message", error.value("message", "")}});
+    }
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t t = std::chrono::system_clock::to_time_t(now);
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  std::tm utc{};
+  gmtime_r(&t, &utc);
+  char time[96];
+  std::snprintf(time, sizeof time, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", utc.tm_year + 1900, utc.tm_mon + 1,
+                utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec, static_cast<int>(ms));
+  shutdownMessage = json{{"type", "shutdown"}, {"reason", reason}, {"objects", objects}, {"time", time}}.dump();
+  for (const auto& s : std::vector<std::shared_ptr<WsSession>>(sessions.begin(), sessions.end()))
+    s->sendText(shutdownMessage);
 }
 
 bool SceneViewer::Impl::enqueueWork(std::function<void()> job) {
@@ -495,6 +765,13 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
   if (type == "ping") return session->sendText(json{{"type", "pong"}, {"id", id}}.dump());
   if (type == "scene") return session->sendText(scene.sceneMessage());
 
+  if (type == "emergencyStop") {
+    // Every page's emergency stop: the system shutdown, at once from the server thread (it never
+    // blocks, and does not wait behind queued commands).
+    ObjectManager::requestSystemShutdown("emergency stop from the Scene Viewer");
+    session->sendText(json{{"type", "result"}, {"id", id}, {"ok", true}}.dump());
+    return announceShutdown();
+  }
   if (onLogMessage(session, type, msg, id, refuse)) return;
 
   std::string object;
@@ -569,7 +846,8 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     };
   } else {
     return refuse("unknown message type '" + type +
-                  "' (known: hello, ping, scene, command, display, setParameter, message, logInfo, logging, logSubscribe)");
+                  "' (known: hello, ping, scene, command, display, setParameter, message, emergencyStop, logInfo, logging, "
+                  "logSubscribe)");
   }
 
   std::weak_ptr<WsSession> weak = session;
@@ -717,6 +995,9 @@ void SceneViewer::start(const SceneViewerOptions& options) {
   }
   if (!(options.rate >= 1 && options.rate <= 240))
     throw std::invalid_argument("SceneViewer: rate must be 1..240 Hz, not " + std::to_string(options.rate));
+  if (!(options.writeTimeout >= 0.1 && options.writeTimeout <= 3600))
+    throw std::invalid_argument("SceneViewer: writeTimeout must be 0.1..3600 s, not " +
+                                std::to_string(options.writeTimeout));
   if (options.port < 0 || options.port > 65535)
     throw std::invalid_argument("SceneViewer: port must be 0..65535, not " + std::to_string(options.port));
   beast::error_code ec;
@@ -727,6 +1008,14 @@ void SceneViewer::start(const SceneViewerOptions& options) {
   if (m.options.webRoot.empty()) m.options.webRoot = defaultWebRoot();
   m.token = options.token;
   if (m.token.empty() && !address.is_loopback()) m.token = generateToken();
+  m.hostNames = {"localhost", "localhost."};
+  m.hostNames.insert(address.is_v6() ? "[" + address.to_string() + "]" : address.to_string());
+  m.anyIpHost = address.is_unspecified();
+  if (m.anyIpHost) {
+    std::string name = asio::ip::host_name();
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    m.hostNames.insert(name);
+  }
   m.ioc = std::make_unique<asio::io_context>(1);
   m.acceptor = std::make_unique<tcp::acceptor>(*m.ioc);
 
@@ -766,7 +1055,12 @@ void SceneViewer::start(const SceneViewerOptions& options) {
   if (!m.token.empty()) url += (page.find('?') == std::string::npos ? "?" : "&") + std::string("token=") + m.token;
 
   m.period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(1.0 / options.rate));
+  m.writeTimeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(options.writeTimeout));
   m.timer = std::make_unique<asio::steady_timer>(*m.ioc);
+  m.acceptTimer = std::make_unique<asio::steady_timer>(*m.ioc);
+  m.acceptPause = std::chrono::milliseconds(0);
+  m.shutdownMessage.clear();
   m.timer->expires_after(m.period);
   m.timer->async_wait([&m](beast::error_code e) {
     if (!e) m.tick();
@@ -774,9 +1068,14 @@ void SceneViewer::start(const SceneViewerOptions& options) {
   m.accept();
   m.connections = 0;
   m.framesBuilt = m.framesSent = m.framesDropped = m.messagesReceived = m.messagesRefused = m.handshakesRefused = 0;
+  m.connectionsClosedForRoom = m.connectionsRefused = m.acceptFailures = m.slowPagesDropped = 0;
   m.workerStop = false;
   m.worker = std::thread([&m] { m.workerLoop(); });
   m.thread = std::thread([&m] { m.ioc->run(); });
+  if (!address.is_loopback())
+    std::cerr << "rp: warning: the Scene Viewer listens on " << options.address << ":" << port
+              << ", beyond this machine: anyone who can reach it and knows the token can move the robots"
+              << " (see the Security section of docs/gui.md)" << std::endl;
   std::lock_guard<std::mutex> lock(m.mutex);
   m.port = port;
   m.url = url;
@@ -801,7 +1100,10 @@ void SceneViewer::stop() {
     beast::error_code ec;
     m.acceptor->close(ec);
     m.timer->cancel();
-    for (const auto& s : std::vector<std::shared_ptr<Impl::WsSession>>(m.sessions.begin(), m.sessions.end())) s->close();
+    m.acceptTimer->cancel();
+    m.announceShutdown();  // a program ending in a shutdown tells its pages why before it goes
+    for (const auto& s : std::vector<std::shared_ptr<Impl::WsSession>>(m.sessions.begin(), m.sessions.end()))
+      s->closeWhenWritten();
   });
   // Give open connections a moment to close, then stop whatever is left.
   std::thread stopper([&m] {
@@ -812,8 +1114,10 @@ void SceneViewer::stop() {
   stopper.join();
   m.sessions.clear();
   m.timer.reset();
+  m.acceptTimer.reset();
   m.acceptor.reset();
-  m.ioc.reset();
+  m.ioc.reset();  // destroys the sessions still held by pending operations
+  m.idleHttp.clear();
   m.pageCount = 0;
   std::lock_guard<std::mutex> lock(m.mutex);
   m.port = 0;
@@ -856,6 +1160,11 @@ SceneViewerStatistics SceneViewer::getStatistics() const {
   s.messagesReceived = m.messagesReceived.load();
   s.messagesRefused = m.messagesRefused.load();
   s.handshakesRefused = m.handshakesRefused.load();
+  s.openConnections = m.openCount.load();
+  s.connectionsClosedForRoom = m.connectionsClosedForRoom.load();
+  s.connectionsRefused = m.connectionsRefused.load();
+  s.acceptFailures = m.acceptFailures.load();
+  s.slowPagesDropped = m.slowPagesDropped.load();
   return s;
 }
 

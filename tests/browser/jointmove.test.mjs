@@ -43,10 +43,29 @@ describe('rp-jointmove', () => {
     if (shots) await ctx.page.screenshot({ path: join(shots, 'joint-move.png') });
   });
 
-  it('refuses a target outside the joint limits', async () => {
+  it('refuses a target outside the joint limits, and the sliders end a margin inside them', async () => {
     const err = await ctx.page.evaluate(() => window.rp.conn.message('jointmove', 'setJoint', JSON.stringify({ joint: 0, value: 100 }))
       .then(() => 'accepted', (e) => e.message));
     assert.match(err, /outside/);
+    const limits = await ctx.page.evaluate(() => {
+      const puma = window.rp.scene.objects.find((o) => o.name === 'puma');
+      return [...document.querySelectorAll('input[data-joint]')].map((s, i) => ({
+        qmin: puma.qmin[i], qmax: puma.qmax[i], min: Number(s.min), max: Number(s.max) }));
+    });
+    assert.equal(limits.length, 6);
+    for (const [i, l] of limits.entries()) {
+      const margin = Math.min(0.05 * (l.qmax - l.qmin), 5 * DEG);
+      assert.ok(Math.abs(l.min * DEG - (l.qmin + margin)) < 1e-9, `joint ${i + 1}: slider starts at ${l.min} deg`);
+      assert.ok(Math.abs(l.max * DEG - (l.qmax - margin)) < 1e-9, `joint ${i + 1}: slider ends at ${l.max} deg`);
+      // A target on the limit itself is refused by the program; one at the slider's end is taken.
+      const onLimit = await ctx.page.evaluate(([j, v]) => window.rp.conn.message('jointmove', 'setJoint',
+        JSON.stringify({ joint: j, value: v })).then(() => 'accepted', (e) => e.message), [i, l.qmax]);
+      assert.match(onLimit, /limits less a margin/);
+    }
+    const atEnd = await ctx.page.evaluate((v) => window.rp.conn.message('jointmove', 'setJoint',
+      JSON.stringify({ joint: 5, value: v })).then(() => 'accepted', (e) => e.message), limits[5].max * DEG - 1e-9);
+    assert.equal(atEnd, 'accepted');
+    await ctx.page.evaluate(() => window.rp.conn.message('jointmove', 'setJoint', JSON.stringify({ joint: 5, value: 0 })));
   });
 
   it('gains set to zero in the control panel reach the servo loop: joint 1\'s torque drops to zero', async () => {

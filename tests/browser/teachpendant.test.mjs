@@ -76,4 +76,62 @@ describe('rp-teachpendant', () => {
     assert.match(bad[2], /'times' must be 1 to 100/);
     assert.match(bad[3], /true or false/);
   });
+
+  it('Stop stops a motion at once: the arm comes to rest short of the target', async () => {
+    const q = await joints();
+    const { positions } = await state();
+    let far = 0;
+    positions.forEach((p, i) => { if (distance(p.q, q) > distance(positions[far].q, q)) far = i; });
+    const D = distance(positions[far].q, q);
+    assert.ok(D > 0.05, `the stored positions are only ${D} rad from here`);
+    // Go, and Stop as soon as the arm has started to move (the page watches the state frames).
+    // Before, Stop only ended a cycle after the current motion: the arm went on to the target.
+    const stoppedAt = await ctx.page.evaluate(([i, start, d]) => new Promise((resolve, reject) => {
+      const puma = () => window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'puma').values;
+      const moved = () => Math.sqrt(start.reduce((acc, x, k) => acc + (x - puma()[k]) ** 2, 0));
+      window.rp.conn.message('teachpendant', 'goto', JSON.stringify({ index: i })).catch(reject);
+      const timer = setInterval(() => {
+        if (moved() < 0.02 * d) return;
+        clearInterval(timer);
+        const m = moved();
+        window.rp.conn.message('teachpendant', 'stop', '').then(() => resolve(m), reject);
+      }, 5);
+    }), [far, q, D]);
+    console.log(`Stop sent ${stoppedAt} rad into a motion of ${D} rad`);
+    await waitInPage(ctx.page, () => window.rp.state && !window.rp.state.busy, null, 20000);
+    await waitInPage(ctx.page, () => {
+      const o = window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'puma');
+      return o.values.slice(6, 12).every((v) => Math.abs(v) < 1e-3);
+    }, null, 20000);
+    const rest = await joints();
+    assert.ok(distance(rest, positions[far].q) > 0.3 * D,
+      `the arm went on to ${distance(rest, positions[far].q)} rad from the target (${D} rad at the start)`);
+    // Go still works after a Stop.
+    await ctx.page.evaluate((i) => window.rp.conn.message('teachpendant', 'goto', JSON.stringify({ index: i })), far);
+    await nearStored(far, 0.01);
+  });
+
+  it('a push force lapses when the page stops repeating it', async () => {
+    // One push, as from a page closed in the middle of a drag: the program zeroes the force
+    // once it has not been repeated for 250 ms (the page repeats it every 50 ms).
+    const reply = await ctx.page.evaluate(() =>
+      window.rp.conn.message('teachpendant', 'push', JSON.stringify({ force: [40, 0, 0] })).then((r) => JSON.parse(r.reply)));
+    assert.equal(reply.pushing, true);
+    const read = () => ctx.page.evaluate(() =>
+      window.rp.conn.message('teachpendant', 'read', '').then((r) => JSON.parse(r.reply)));
+    const deadline = Date.now() + 20000;
+    let now = await read();
+    while (now.pushing && Date.now() < deadline) now = await read();
+    assert.equal(now.pushing, false);
+    assert.equal(now.pushesLapsed, reply.pushesLapsed + 1);
+    // A push repeated holds, and a zero force ends it.
+    for (let i = 0; i < 5; ++i) {
+      const r = await ctx.page.evaluate(() => window.rp.conn.message('teachpendant', 'push', JSON.stringify({ force: [5, 0, 0] }))
+        .then((x) => JSON.parse(x.reply)));
+      assert.equal(r.pushing, true);
+    }
+    const end = await ctx.page.evaluate(() => window.rp.conn.message('teachpendant', 'push', JSON.stringify({ force: [0, 0, 0] }))
+      .then((x) => JSON.parse(x.reply)));
+    assert.equal(end.pushing, false);
+  });
 });

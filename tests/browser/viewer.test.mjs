@@ -82,6 +82,42 @@ describe('Scene Viewer on work_cell', () => {
     await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'puma').display === 'solid');
   });
 
+  it('picking: parts not drawn are not picked, and a right drag (pan) opens no menu', async () => {
+    // The work piece with the arm out of the way, then with its own parts hidden (as a hidden
+    // link is): what is not drawn is not picked.
+    const picks = await ctx.page.evaluate(() => {
+      const v = window.rp.view;
+      const puma = v.objects.get('puma').root;
+      const piece = v.objects.get('workpiece').root;
+      puma.visible = false;
+      const p = v.screenPosition('workpiece');
+      const shown = v.pick(p.x, p.y);
+      const saved = [];
+      piece.traverse((c) => { if (c !== piece) { saved.push([c, c.visible]); c.visible = false; } });
+      const hiddenParts = v.pick(p.x, p.y);
+      for (const [c, vis] of saved) c.visible = vis;
+      puma.visible = true;
+      return { shown, hiddenParts };
+    });
+    assert.equal(picks.shown, 'workpiece');
+    assert.notEqual(picks.hiddenParts, 'workpiece');
+    // A right drag starting on the work piece pans the view; no menu opens.
+    const pos = await ctx.page.evaluate(() => window.rp.view.screenPosition('workpiece'));
+    const target0 = await ctx.page.evaluate(() => window.rp.view.controls.target.toArray());
+    await ctx.page.mouse.move(pos.x, pos.y);
+    await ctx.page.mouse.down({ button: 'right' });
+    await ctx.page.mouse.move(pos.x + 60, pos.y + 30, { steps: 6 });
+    await ctx.page.mouse.up({ button: 'right' });
+    assert.equal(await ctx.page.evaluate(() => document.getElementById('popup-menu').classList.contains('hidden')), true,
+      'a right drag opened the pop-up menu');
+    assert.notDeepEqual(await ctx.page.evaluate(() => window.rp.view.controls.target.toArray()), target0, 'the view did not pan');
+    // A right click where the button is released opens it.
+    const now = await ctx.page.evaluate(() => window.rp.view.screenPosition('gripper'));
+    await ctx.page.mouse.click(now.x, now.y, { button: 'right' });
+    await ctx.page.waitForSelector('#popup-menu:not(.hidden)');
+    await ctx.page.keyboard.press('Escape');
+  });
+
   it('control panel of the Puma: live joint state, and a tuned gain reaches the servo loop', async () => {
     await ctx.page.click('#object-table tr[data-object="puma"]', { button: 'right' });
     await ctx.page.click('#popup-menu .item[data-action="Control Panel..."]');
@@ -101,11 +137,55 @@ describe('Scene Viewer on work_cell', () => {
     await kp.dispatchEvent('change');
     await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'puma').panel.fields
       .find((f) => f.name === 'kp').value[2] === 1234.5);
-    // Out of range: refused with a message, the value shown again.
-    await kp.fill('-1');
+    // Invalid input is refused in the page, with the error next to the field, and nothing is
+    // sent (an empty box used to send 0 to the running arm).
+    await ctx.page.evaluate(() => {
+      window.sentSetParameter = [];
+      const ws = window.rp.conn.ws;
+      const send = ws.send.bind(ws);
+      ws.send = (text) => {
+        if (JSON.parse(text).type === 'setParameter') window.sentSetParameter.push(text);
+        send(text);
+      };
+    });
+    const error = panel.locator('.field-error[data-error="kp"]');
+    for (const [typed, why] of [['', /kp\[3\]: enter a number; not sent/], ['NaN', /'NaN' is not a number/],
+      ['1e999', /1e999 is too large/], ['-', /'-' is not a number/], ['-1', /-1 is outside \[0, /],
+      ['12abc', /'12abc' is not a number/], ['Infinity', /'Infinity' is not a number/]]) {
+      await kp.fill(typed);
+      await kp.dispatchEvent('change');
+      await error.waitFor({ state: 'visible' });
+      assert.match(await error.textContent(), why);
+    }
+    assert.deepEqual(await ctx.page.evaluate(() => window.sentSetParameter), []);
+    assert.equal(await ctx.page.evaluate(() => window.rp.scene.objects.find((o) => o.name === 'puma').panel.fields
+      .find((f) => f.name === 'kp').value[2]), 1234.5);
+    // A valid value is sent and taken, and the error goes away.
+    await kp.fill('1200');
     await kp.dispatchEvent('change');
-    await ctx.page.waitForSelector('#messages:not(.hidden)');
-    assert.match(await ctx.page.textContent('#messages'), /kp/);
+    await waitInPage(ctx.page, () => window.rp.scene.objects.find((o) => o.name === 'puma').panel.fields
+      .find((f) => f.name === 'kp').value[2] === 1200);
+    await error.waitFor({ state: 'hidden' });
+    // The server refuses what the page would not send (another client): the reply names the field.
+    const refused = await ctx.page.evaluate(async () => {
+      const out = [];
+      for (const value of [null, 'x', -1, 1e300]) {
+        try {
+          await window.rp.conn.request({ type: 'setParameter', object: 'puma', name: 'kp', value, index: 2 });
+          out.push('taken');
+        } catch (e) { out.push(e.message); }
+      }
+      try {
+        await window.rp.conn.request({ type: 'setParameter', object: 'puma', name: 'kp', values: [1, 2] });
+        out.push('taken');
+      } catch (e) { out.push(e.message); }
+      return out;
+    });
+    assert.match(refused[0], /'value' must be a number/);
+    assert.match(refused[1], /'value' must be a number/);
+    assert.match(refused[2], /'kp' = -1.* is outside/);
+    assert.match(refused[3], /'kp' = .* is outside/);
+    assert.match(refused[4], /'kp' needs 6 values, got 2/);
   });
 
   it('two pages at once both receive state', async () => {

@@ -1,5 +1,7 @@
 // The page side of the Scene Viewer protocol (version 1): a WebSocket that reconnects, JSON
 // messages, and binary state frames decoded into plain arrays. See docs/gui.md.
+import { addEmergencyStop, showShutdown } from './ui.js';
+
 export const PROTOCOL = 1;
 const MAGIC = 0x31535052; // "RPS1"
 
@@ -50,6 +52,8 @@ export class Connection {
     this.frames = 0;
     this.connected = false;
     this.hello = null;
+    this.shutdown = null; // the system shutdown the program reported, kept after it ended
+    addEmergencyStop(this);
     this.open();
   }
 
@@ -70,7 +74,7 @@ export class Connection {
       this.connected = false;
       for (const { reject } of this.pending.values()) reject(new Error('connection closed'));
       this.pending.clear();
-      this.onStatus('disconnected: reconnecting', false);
+      this.onStatus(this.shutdown ? 'program shut down: reconnecting' : 'disconnected: reconnecting', false);
       setTimeout(() => this.open(), 1000);
     };
     ws.onmessage = (ev) => {
@@ -88,6 +92,10 @@ export class Connection {
       }
       const msg = JSON.parse(ev.data);
       if (msg.type === 'hello') this.hello = msg;
+      else if (msg.type === 'shutdown') {
+        this.shutdown = msg;
+        showShutdown(msg);
+      }
       else if (msg.type === 'scene') {
         this.scene = msg;
         this.onScene(msg);

@@ -25,8 +25,11 @@ function build(desc) {
   for (let i = 0; i < desc.joints; ++i) {
     const input = document.createElement('input');
     input.type = 'range';
-    input.min = String(desc.qmin[i] * deg);
-    input.max = String(desc.qmax[i] * deg);
+    // The sliders end a margin inside the joint limits (5 % of the range, at most 5 degrees; the
+    // program refuses targets beyond it): the arm lags its setpoint and would overshoot a limit.
+    const margin = Math.min(0.05 * (desc.qmax[i] - desc.qmin[i]), 5 / deg);
+    input.min = String((desc.qmin[i] + margin) * deg);
+    input.max = String((desc.qmax[i] - margin) * deg);
     input.step = '0.1';
     input.dataset.joint = String(i);
     input.value = '0';

@@ -47,8 +47,19 @@ const showMenu = (name, x, y) => {
 };
 const list = new ObjectList(document.getElementById('object-list'), showMenu);
 
-view.renderer.domElement.addEventListener('contextmenu', (ev) => {
-  ev.preventDefault();
+// The pop-up menu opens when the right button is released where it was pressed: a right drag
+// pans the view and opens nothing (the browser's contextmenu event comes at the press on Linux).
+const canvas = view.renderer.domElement;
+let rightPress = null;
+canvas.addEventListener('contextmenu', (ev) => ev.preventDefault());
+canvas.addEventListener('pointerdown', (ev) => {
+  if (ev.button === 2) rightPress = { x: ev.clientX, y: ev.clientY };
+});
+canvas.addEventListener('pointerup', (ev) => {
+  if (ev.button !== 2 || !rightPress) return;
+  const moved = Math.hypot(ev.clientX - rightPress.x, ev.clientY - rightPress.y);
+  rightPress = null;
+  if (moved > 4) return;
   const name = view.pick(ev.clientX, ev.clientY);
   if (name) showMenu(name, ev.clientX, ev.clientY);
 });

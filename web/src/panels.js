@@ -1,5 +1,6 @@
 // Object List window, the object pop-up menu (Figure 17) and control panels (Figure 18),
 // rendered from the scene description and the state frames.
+import { parseNumberInput } from './ui.js';
 
 function el(tag, attrs = {}, ...children) {
   const e = document.createElement(tag);
@@ -92,8 +93,7 @@ export class ControlPanel {
     const key = JSON.stringify(desc.panel);
     this.desc = desc;
     this.title.textContent = desc.panel.title;
-    this.status.textContent = desc.error.code ? `Error ${desc.error.code}: ${desc.error.message}` : 'No error';
-    this.status.className = `panel-status ${desc.error.code ? 'error' : ''}`;
+    this.showStatus();
     // Values change often (a tuned gain comes back in the next description): the panel is
     // rebuilt only when its fields change, and the inputs are updated in place otherwise, except
     // the one being edited, so that nothing typed is lost.
@@ -113,18 +113,35 @@ export class ControlPanel {
       if (f.name === 'errorCode') continue;
       const n = f.kind === 'vector' ? f.size : 1;
       const cell = el('div', { class: 'values' });
+      let error = null;
       if (f.tunable) {
+        // What is wrong with the value typed last, next to the field (the page's own check or
+        // the server's reply); cleared when a value is taken.
+        error = el('div', { class: 'field-error hidden', 'data-error': f.name });
+        const showError = (text) => {
+          error.textContent = text;
+          error.classList.toggle('hidden', !text);
+        };
         for (let i = 0; i < n; ++i) {
-          const input = el('input', { type: 'number', step: 'any', 'data-field': f.name, 'data-index': String(i) });
+          const input = el('input', { type: 'text', inputmode: 'decimal', autocomplete: 'off', spellcheck: 'false',
+            'data-field': f.name, 'data-index': String(i) });
           if (f.value) input.value = f.value[i];
-          if (f.max > f.min) {
-            input.min = f.min;
-            input.max = f.max;
-          }
+          if (f.max > f.min) input.title = `${f.min} to ${f.max}`;
+          const label = f.kind === 'vector' ? `${f.name}[${i + 1}]` : f.name;
           input.addEventListener('change', () => {
-            const v = Number(input.value);
+            // Refused in the page: never send a value the user did not type (an empty or
+            // malformed box used to go out as 0).
+            const v = parseNumberInput(input.value, f.min, f.max);
+            if (v instanceof Error) {
+              input.classList.add('invalid');
+              showError(`${label}: ${v.message}; not sent`);
+              return;
+            }
+            input.classList.remove('invalid');
+            showError('');
             this.conn.setParameter(this.name, f.name, v, f.kind === 'vector' ? i : undefined)
               .catch((e) => {
+                showError(`${label}: ${e.message}`);
                 this.notify(`${this.name}.${f.name}: ${e.message}`);
                 const now = this.desc.panel.fields.find((x) => x.name === f.name);
                 if (now && now.value) input.value = now.value[i];
@@ -140,18 +157,32 @@ export class ControlPanel {
           this.cells.push({ span, index: f.stateIndex + i, field: f });
         }
       }
-      rows.push(el('div', { class: 'row' }, el('label', {}, `${f.label}${f.unit ? ` [${f.unit}]` : ''}${f.tunable ? ' (tunable)' : ''}`), cell));
+      const row = el('div', { class: 'row' }, el('label', {}, `${f.label}${f.unit ? ` [${f.unit}]` : ''}${f.tunable ? ' (tunable)' : ''}`), cell);
+      if (error) row.append(error);
+      rows.push(row);
     }
     this.body.replaceChildren(...rows);
   }
+  // The object's error status, or the system shutdown once the program reported one.
+  showStatus() {
+    const e = this.desc.error;
+    const down = this.conn.shutdown;
+    let text = 'No error';
+    if (e.code) text = `Error ${e.code}: ${e.message}`;
+    else if (down) text = `System shutdown: ${down.reason}`;
+    this.status.textContent = text;
+    this.status.className = `panel-status ${e.code || down ? 'error' : ''}`;
+    this.shownShutdown = down;
+  }
   updateInputs(desc) {
     for (const { input, name, index } of this.inputs) {
-      if (input === document.activeElement) continue;
+      if (input === document.activeElement || input.classList.contains('invalid')) continue;
       const f = desc.panel.fields.find((x) => x.name === name);
       if (f && f.value) input.value = f.value[index];
     }
   }
   setValues(values) {
+    if (this.desc && this.conn.shutdown !== this.shownShutdown) this.showStatus();
     for (const c of this.cells) {
       const v = values[c.index];
       if (v === undefined) continue;

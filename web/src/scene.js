@@ -232,7 +232,13 @@ export class SceneView {
     const p = new THREE.Vector2(((clientX - r.left) / r.width) * 2 - 1, -((clientY - r.top) / r.height) * 2 + 1);
     this.raycaster.setFromCamera(p, this.camera);
     const roots = [...this.objects.values()].filter((o) => o.root.visible).map((o) => o.root);
-    const hit = this.raycaster.intersectObjects(roots, true)[0];
+    // three.js' raycaster also hits what is not drawn: only a mesh that is visible, with every
+    // parent visible (not a hidden object, a hidden link, or a link not placed yet), is picked.
+    const shown = (obj) => {
+      for (let x = obj; x; x = x.parent) if (!x.visible) return false;
+      return true;
+    };
+    const hit = this.raycaster.intersectObjects(roots, true).find((h) => shown(h.object));
     return hit ? hit.object.userData.object : null;
   }
 

@@ -17,6 +17,10 @@ inline constexpr int kSceneViewerProtocolVersion = 1;
 /// Default TCP port of the Scene Viewer; when it is taken the server tries the next ports.
 inline constexpr int kSceneViewerDefaultPort = 7070;
 
+/// Most connections (pages and HTTP requests) the Scene Viewer keeps open at once; another one
+/// takes the place of the HTTP connection that has waited longest for a request, or is closed.
+inline constexpr std::size_t kSceneViewerMaxConnections = 64;
+
 /// Where and how the Scene Viewer listens.
 struct SceneViewerOptions {
   std::string address = "127.0.0.1";  ///< IP address to listen on (IPv4 or IPv6 literal)
@@ -29,6 +33,9 @@ struct SceneViewerOptions {
   std::string webRoot;  ///< folder of the built front end; empty: defaultWebRoot()
   double rate = 60;     ///< state frames per second sent to each page [Hz], 1..240
   std::string startPage = "index.html";  ///< page (with query) the printed URL opens
+  /// A page whose socket has not taken a message for this long (it stopped reading) is dropped [s],
+  /// 0.1..3600.
+  double writeTimeout = 10;
 };
 
 /// Counters of a running Scene Viewer (for tests and the measurement script).
@@ -40,7 +47,13 @@ struct SceneViewerStatistics {
   std::uint64_t framesDropped = 0;   ///< state frames replaced by a newer one before a page took them
   std::uint64_t messagesReceived = 0;  ///< commands received
   std::uint64_t messagesRefused = 0;   ///< commands answered with an error
-  std::uint64_t handshakesRefused = 0; ///< WebSocket upgrades refused (token, Origin, path)
+  std::uint64_t handshakesRefused = 0; ///< WebSocket upgrades refused (token, Origin, Host, path)
+  std::size_t openConnections = 0;     ///< TCP connections open now (pages and HTTP)
+  /// HTTP connections waiting for a request closed to make room for a new connection
+  std::uint64_t connectionsClosedForRoom = 0;
+  std::uint64_t connectionsRefused = 0;  ///< new connections closed at once: kSceneViewerMaxConnections busy
+  std::uint64_t acceptFailures = 0;      ///< accept errors (such as out of file descriptors)
+  std::uint64_t slowPagesDropped = 0;    ///< pages dropped because they stopped reading (writeTimeout)
 };
 
 /// The process's Scene Viewer server: one thread running an HTTP + WebSocket server (Boost.Beast)
@@ -59,7 +72,8 @@ class SceneViewer {
   /// The process's viewer (not started). Real-time safe: no.
   static SceneViewer& instance();
 
-  /// Starts listening and the server thread; prints nothing (see getUrl()).
+  /// Starts listening and the server thread; prints nothing (see getUrl()) but a warning on
+  /// stderr when the address is not a loopback address.
   /// @param[in] options  address, port, token, web root and rate
   /// @throws std::invalid_argument for a bad address, port or rate
   /// @throws std::runtime_error if it cannot listen (port taken and no fallback)
