@@ -5,6 +5,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <thread>
@@ -62,6 +64,70 @@ TEST(HardwareManipulator, PumaBehindAHardwareServerHoldsMovesAndShutsDownWhenThe
     ASSERT_TRUE(ObjectManager::waitForShutdown(5));
     EXPECT_NE(puma.getErrorStatus().message.find("hardware failure"), std::string::npos)
         << puma.getErrorStatus().message;
+  }
+  RoboticPlatform::setSimulationModeOn();
+  RoboticPlatform::useSimulatedClock();
+  ObjectManager::resetShutdown();
+}
+
+// Delegates to the default control and stalls the servo thread once, as a busy machine may.
+class StallOnce : public ServoControl {
+ public:
+  explicit StallOnce(DefaultPositionControl& inner) : inner_(inner) {}
+  ~StallOnce() override { releaseFromManipulator(); }
+  void calculate() override {
+    if (++calls == 300) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    inner_.calculate();
+  }
+  std::atomic<int> calls{0};
+
+ private:
+  DefaultPositionControl& inner_;
+};
+
+// Joint 1 at a constant 0.5 rad/s from where the arm is.
+class Ramp : public TrajectoryGenerator {
+ public:
+  explicit Ramp(const JointVector& start) : start_(start) {}
+  ~Ramp() override { releaseFromManipulators(); }
+  bool getCurrentSetpoint(double time, Setpoint& sp) override {
+    if (t0_ < 0) t0_ = time;
+    sp.position = start_;
+    sp.position(0) += 0.5 * std::min(time - t0_, 1.0);
+    sp.velocity.setZero();
+    sp.velocity(0) = time - t0_ < 1.0 ? 0.5 : 0.0;
+    return true;
+  }
+
+ private:
+  JointVector start_;
+  double t0_ = -1;
+};
+
+TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
+  // 100 ms without a cycle while joint 1 moves at 0.5 rad/s: the encoders moved 0.05 rad, which
+  // divided by one period (1 ms) read as 50 rad/s and tripped the 2 rad/s velocity limit. The
+  // velocity is taken over the time that really passed.
+  const std::string name = "test-stall-" + std::to_string(::getpid());
+  test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
+  ASSERT_TRUE(server.readLine(10000).has_value()) << "the server did not start";
+  RoboticPlatform::setConfiguration(Configuration::parse(
+      "[leader]\nclass Puma560\nsimulationMode off\nhwserver " + name + "\n", "rp.cfg"));
+  RoboticPlatform::setSimulationModeOff();
+  RoboticPlatform::useRealClock();
+  ObjectManager::resetShutdown();
+  {
+    Puma560 puma("leader");
+    StallOnce stall(puma.getDefaultPositionControl());
+    Ramp ramp(puma.getJointPosition());
+    puma.setServoControl(stall);
+    puma.setTrajectoryGenerator(ramp);
+    for (int i = 0; i < 300 && stall.calls.load() < 1000; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    EXPECT_GE(stall.calls.load(), 1000);
+    EXPECT_GE(puma.getStatistics().missedCycles, 90u) << "the stall happened";
+    EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
+    EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+    puma.clearTrajectoryGenerator();
   }
   RoboticPlatform::setSimulationModeOn();
   RoboticPlatform::useSimulatedClock();
