@@ -63,7 +63,7 @@ void watcher() {
     }
     reg.doneCv.notify_all();
     if (int sig = reg.signalNumber.load()) {
-      std::fflush(nullptr);
+      std::fflush(stderr);  // not stdout: a main thread blocked writing to a full pipe may hold its lock
       _exit(128 + sig);
     }
   }

@@ -215,6 +215,7 @@ void RoboticObject::startControlLoop() {
 }
 
 void RoboticObject::stopControlLoop() {
+  beforeControlLoopStops();  // e.g. a manipulator's hold until the arm is at rest
   withdrawObject();  // the destructors call this first: other threads keep off from here on
   if (ControlProgram* p = getControlProgram()) p->stop();
 }

@@ -301,14 +301,14 @@ void DefaultManipulator::startShutdown() {
   // shutdown stops it after that.
   int expected = 0;
   shutdownPhase_.compare_exchange_strong(expected, 1);
-  if (!isRunning()) {
+  if (!isRunning() || loopEnded_.load()) {
     if (board_) writeOutputsOff();
     shutdownPhase_.store(2);
   }
 }
 
 void DefaultManipulator::holdUntilSafe() {
-  if (!isRunning()) return;
+  if (!isRunning() || loopEnded_.load()) return;
   // A loop stopped by runCycles() on a paused simulated clock cannot run the hold: nothing
   // moves while the simulated clock stands still, and the brakes go on when the loop ends.
   pauseAtCycle_.store(0, std::memory_order_relaxed);
@@ -316,7 +316,7 @@ void DefaultManipulator::holdUntilSafe() {
   int expected = 0;
   shutdownPhase_.compare_exchange_strong(expected, 1);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kShutdownTimeout + 2.0);
-  while (isRunning() && shutdownPhase_.load() != 2 && std::chrono::steady_clock::now() < deadline)
+  while (isRunning() && !loopEnded_.load() && shutdownPhase_.load() != 2 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::microseconds(500));
 }
 
@@ -396,10 +396,13 @@ void DefaultManipulator::enterControl() {
   servoThread_.store(std::this_thread::get_id());
   simulatedClock_ = dynamic_cast<SimulatedClock*>(&getClock());
   lastCycleTime_ = -1;
+  loopEnded_.store(false);
   // The rate is final now (rp.cfg's qmotorConfig may have set it after construction): the
-  // velocity filter takes this period (the servo controls take it in activate()).
-  if (board_ && velocity_->getSamplePeriod() != getPeriod()) {
-    velocity_ = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
+  // velocity filter takes this period (the servo controls take it in activate()); a restarted
+  // loop starts the filter afresh from where the arm is.
+  if (board_) {
+    if (velocity_->getSamplePeriod() != getPeriod()) velocity_ = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
+    velocity_->reset();
     (void)velocity_->differentiate(q_);
   }
   power_ = powerRequested_.load();
@@ -414,7 +417,9 @@ void DefaultManipulator::exitControl() {
   if (board_) writeOutputsOff();
   sim_->setBrakes(true);
   publish();
-  if (shutdownPhase_.load() == 1) shutdownPhase_.store(2);
+  loopEnded_.store(true);
+  int hold = 1;
+  shutdownPhase_.compare_exchange_strong(hold, 2);
 }
 
 void DefaultManipulator::control() {
@@ -425,9 +430,12 @@ void DefaultManipulator::control() {
   // 0. An arm with no hardware waits, unpowered, for setSimulationModeOn(); half a second
   // without it is a fault (a program that forgot it, or -nosim without the arm's hardware).
   if (noHardware_.load(std::memory_order_relaxed)) {
+    // Real time, whatever the loop's clock: the program's own thread must get to run.
+    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    if (noHardwareSince_ < 0) noHardwareSince_ = now;
     if (isSimulationModeOn()) {
       noHardware_.store(false, std::memory_order_relaxed);
-    } else if (++noHardwareCycles_ > static_cast<std::uint64_t>(getRate() / 2) && shutdownPhase_.load() == 0) {
+    } else if (now - noHardwareSince_ > 0.5 && shutdownPhase_.load() == 0) {
       std::snprintf(errorBuffer_, sizeof errorBuffer_,
                     "%.60s: simulation mode is off but no hardware is configured for it (rp.cfg 'hwserver NAME', "
                     "or simulation on)", nameBuffer_);

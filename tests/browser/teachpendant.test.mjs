@@ -86,7 +86,9 @@ describe('rp-teachpendant', () => {
     assert.ok(D > 0.05, `the stored positions are only ${D} rad from here`);
     // Go, and Stop as soon as the arm has started to move (the page watches the state frames).
     // Before, Stop only ended a cycle after the current motion: the arm went on to the target.
-    const stoppedAt = await ctx.page.evaluate(([i, start, d]) => new Promise((resolve, reject) => {
+    // The reply to Stop comes once the brake has taken over: the state right after it (position
+    // and velocity of each joint) is where the braking starts.
+    const { stoppedAt, qs, vs } = await ctx.page.evaluate(([i, start, d]) => new Promise((resolve, reject) => {
       const puma = () => window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'puma').values;
       const moved = () => Math.sqrt(start.reduce((acc, x, k) => acc + (x - puma()[k]) ** 2, 0));
       window.rp.conn.message('teachpendant', 'goto', JSON.stringify({ index: i })).catch(reject);
@@ -94,7 +96,10 @@ describe('rp-teachpendant', () => {
         if (moved() < 0.02 * d) return;
         clearInterval(timer);
         const m = moved();
-        window.rp.conn.message('teachpendant', 'stop', '').then(() => resolve(m), reject);
+        window.rp.conn.message('teachpendant', 'stop', '').then(() => {
+          const v = puma();
+          resolve({ stoppedAt: m, qs: v.slice(0, 6), vs: v.slice(6, 12) });
+        }, reject);
       }, 5);
     }), [far, q, D]);
     console.log(`Stop sent ${stoppedAt} rad into a motion of ${D} rad`);
@@ -104,8 +109,19 @@ describe('rp-teachpendant', () => {
       return o.values.slice(6, 12).every((v) => Math.abs(v) < 1e-3);
     }, null, 20000);
     const rest = await joints();
-    assert.ok(distance(rest, positions[far].q) > 0.3 * D,
-      `the arm went on to ${distance(rest, positions[far].q)} rad from the target (${D} rad at the start)`);
+    // From where the brake took over, each joint stops within its braking distance at 80 % of its
+    // acceleration limit (the Puma's 4, 4, 5, 8, 8, 8 rad/s^2), allowing for a state frame up to
+    // 0.1 s old on a loaded machine. Before, Stop only ended a cycle after the current motion.
+    const amax = [4, 4, 5, 8, 8, 8];
+    const bound = vs.map((v, k) => (v * v) / (2 * 0.8 * amax[k]) + Math.abs(v) * 0.1 + 0.005);
+    rest.forEach((x, k) => assert.ok(Math.abs(x - qs[k]) <= bound[k],
+      `joint ${k + 1} went on ${Math.abs(x - qs[k])} rad after Stop (braking bound ${bound[k]} rad)`));
+    // And where the target lay beyond that, the arm came to rest short of it.
+    const reach = Math.sqrt(bound.reduce((a, b) => a + b * b, 0));
+    if (distance(qs, positions[far].q) > reach + 0.02) {
+      assert.ok(distance(rest, positions[far].q) > 0.01,
+        `the arm went on to ${distance(rest, positions[far].q)} rad from the target (${D} rad at the start)`);
+    }
     // Go still works after a Stop.
     await ctx.page.evaluate((i) => window.rp.conn.message('teachpendant', 'goto', JSON.stringify({ index: i })), far);
     await nearStored(far, 0.01);

@@ -214,6 +214,63 @@ TEST_F(SafetyTest, AfterAFaultTheDampedHoldStopsTheArmThenTheBrakesEngage) {
   ObjectManager::setShutdownTimeout(5);
 }
 
+// A Puma whose destructor records the state its servo loop published last (the loop has stopped).
+class RecordingPuma : public Puma560 {
+ public:
+  RecordingPuma(JointVector& velocity, bool& power) : velocity_(velocity), power_(power) {}
+  ~RecordingPuma() override {
+    stopControlLoop();
+    velocity_ = getJointVelocity();
+    power_ = isArmPowerOn();
+  }
+
+ private:
+  JointVector& velocity_;
+  bool& power_;
+};
+
+// Joint 1 at a constant speed from where the arm is.
+class JointRamp : public TrajectoryGenerator {
+ public:
+  explicit JointRamp(double speed) : speed_(speed) {}
+  ~JointRamp() override { releaseFromManipulators(); }
+  bool getCurrentSetpoint(double time, Setpoint& sp) override {
+    if (t0_ < 0) {
+      t0_ = time;
+      start_ = sp.position;  // the hold position the manipulator filled in
+    }
+    sp.position = start_;
+    sp.position(0) += speed_ * (time - t0_);
+    sp.velocity.setZero();
+    sp.velocity(0) = speed_;
+    return true;
+  }
+
+ private:
+  double speed_, t0_ = -1;
+  JointVector start_;
+};
+
+TEST_F(SafetyTest, DestroyingAMovingArmHoldsItUntilAtRestFirst) {
+  // Before, the most-derived destructor stopped the loop at once: the power went off with the arm
+  // moving. Now stopControlLoop() first runs the damped hold until the arm is at rest.
+  JointVector velocity;
+  bool power = true;
+  {
+    JointRamp ramp(0.8);
+    simClock().pause();
+    RecordingPuma puma(velocity, power);
+    puma.setTrajectoryGenerator(ramp);
+    ASSERT_TRUE(puma.runCycles(300));
+    ASSERT_GT(std::abs(puma.getJointVelocity()(0)), 0.5) << "the arm moves";
+    simClock().resume();  // the ramp goes on (joint 1 is 2 rad from its limit) until the hold begins
+  }
+  ASSERT_EQ(velocity.size(), 6);
+  for (int i = 0; i < 6; ++i) EXPECT_LT(std::abs(velocity(i)), 1e-3) << "joint " << i + 1 << " at rest";
+  EXPECT_FALSE(power);
+  EXPECT_FALSE(ObjectManager::isShutdownRequested()) << "destroying an arm is no system shutdown";
+}
+
 // Pushes joint 1 with a constant torque and stalls the servo thread once for 60 ms, as a busy
 // machine may; records each cycle's time and joint-1 velocity.
 class StallingPush : public ServoControl {

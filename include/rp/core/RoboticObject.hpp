@@ -213,10 +213,15 @@ class RoboticObject {
   /// (publishObject()). Without a loop it only publishes the object.
   /// Real-time safe: no.
   void startControlLoop();
-  /// Withdraws the object from other threads (withdrawObject()), then stops the control loop and
+  /// Lets the object bring what its loop drives to a safe state (beforeControlLoopStops()),
+  /// withdraws the object from other threads (withdrawObject()), then stops the control loop and
   /// waits for its thread (derived destructors call this first).
   /// Real-time safe: no.
   void stopControlLoop();
+  /// Called first by stopControlLoop() while the loop still runs: a class whose loop drives
+  /// hardware waits here until it is safe to stop (a manipulator holds its arm until at rest and
+  /// switches the power off). The default does nothing.
+  virtual void beforeControlLoopStops() {}
   /// @}
 
   /// A plain description of the object for the object list. Real-time safe: no.

@@ -117,6 +117,11 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void releaseServoControl(ServoControl& control) override;
   void releaseTrajectoryGenerator(TrajectoryGenerator& generator) override;
 
+  /// Holds a powered arm until it is at rest and switches the power off (as in a shutdown),
+  /// before the loop stops: so destroying a manipulator (its destructor calls stopControlLoop())
+  /// never cuts the power of a moving arm. Bounded: at most about 5 s.
+  void beforeControlLoopStops() override { holdUntilSafe(); }
+
   /// Starts the damped hold (velocity damping plus gravity compensation, within the torque
   /// limits) until the arm is at rest, then switches the power off and engages the brakes. The
   /// servo loop goes on running (holding the outputs off) until the system shutdown stops it.
@@ -196,7 +201,8 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   std::atomic<bool> zeroGravity_{false};
   std::atomic<bool> holdHere_{false};
   std::atomic<bool> noHardware_{false};  // simulation off, no hardware: unpowered until simulation is on
-  std::uint64_t noHardwareCycles_ = 0;
+  std::atomic<bool> loopEnded_{false};   // exitControl() ran: no cycle will complete a hold
+  double noHardwareSince_ = -1;          // steady-clock time the no-hardware wait began [s]
   std::atomic<int> shutdownPhase_{0};  // 0 running, 1 damped hold, 2 complete
   std::atomic<std::thread::id> servoThread_{};
   std::atomic<std::uint64_t> pauseAtCycle_{0};
