@@ -30,16 +30,22 @@ class StepTo : public TrajectoryGenerator {
   JointVector target_;
 };
 
-TEST(HardwareManipulator, PumaBehindAHardwareServerHoldsMovesAndShutsDownWhenTheServerDies) {
-  const std::string name = "test-arm-" + std::to_string(::getpid());
-  // -watchdog 5000: a servo loop stalled by a loaded test machine is not cut off by the server.
-  test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
-  ASSERT_TRUE(server.readLine(10000).has_value()) << "the server did not start";
+// Starts `rp-hwserver -board puma560` named NAME-PID and configures [leader] as a Puma behind
+// it, on the real clock. -watchdog 5000: a servo loop stalled by a loaded test machine is not cut
+// off by the server.
+test::ChildProcess startServer(const std::string& prefix) {
+  const std::string name = prefix + "-" + std::to_string(::getpid());
   RoboticPlatform::setConfiguration(Configuration::parse(
       "[leader]\nclass Puma560\nsimulationMode off\nhwserver " + name + "\n", "rp.cfg"));
   RoboticPlatform::setSimulationModeOff();
   RoboticPlatform::useRealClock();
   ObjectManager::resetShutdown();
+  return test::ChildProcess({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
+}
+
+TEST(HardwareManipulator, PumaBehindAHardwareServerHoldsMovesAndShutsDownWhenTheServerDies) {
+  test::ChildProcess server = startServer("test-arm");
+  ASSERT_TRUE(server.readLine(10000).has_value()) << "the server did not start";
   {
     Puma560 puma("leader");
     ASSERT_TRUE(puma.usesHardware());
@@ -108,14 +114,8 @@ TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
   // 100 ms without a cycle while joint 1 moves at 0.5 rad/s: the encoders moved 0.05 rad, which
   // divided by one period (1 ms) read as 50 rad/s and tripped the 2 rad/s velocity limit. The
   // velocity is taken over the time that really passed.
-  const std::string name = "test-stall-" + std::to_string(::getpid());
-  test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
+  test::ChildProcess server = startServer("test-stall");
   ASSERT_TRUE(server.readLine(10000).has_value()) << "the server did not start";
-  RoboticPlatform::setConfiguration(Configuration::parse(
-      "[leader]\nclass Puma560\nsimulationMode off\nhwserver " + name + "\n", "rp.cfg"));
-  RoboticPlatform::setSimulationModeOff();
-  RoboticPlatform::useRealClock();
-  ObjectManager::resetShutdown();
   {
     Puma560 puma("leader");
     StallOnce stall(puma.getDefaultPositionControl());
