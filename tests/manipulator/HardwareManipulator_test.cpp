@@ -122,7 +122,7 @@ TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
     Ramp ramp(puma.getJointPosition());
     puma.setServoControl(stall);
     puma.setTrajectoryGenerator(ramp);
-    for (int i = 0; i < 300 && stall.calls.load() < 1000; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    for (int i = 0; i < 3000 && stall.calls.load() < 1000; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     EXPECT_GE(stall.calls.load(), 1000);
     EXPECT_GE(puma.getStatistics().missedCycles, 90u) << "the stall happened";
     EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();

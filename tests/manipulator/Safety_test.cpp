@@ -307,7 +307,7 @@ TEST(BusyMachine, OnTheRealClockTheSimulatedArmMovesOnThroughAStall) {
     Puma560 puma;
     StallingPush push;
     puma.setServoControl(push);
-    for (int i = 0; i < 400 && push.count.load() < StallingPush::kCycles; ++i)
+    for (int i = 0; i < 4000 && push.count.load() < StallingPush::kCycles; ++i)
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     ASSERT_EQ(push.count.load(), StallingPush::kCycles);
     puma.disableArmPower();
