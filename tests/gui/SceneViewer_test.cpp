@@ -379,6 +379,11 @@ class FdLimitServer {
 };
 
 TEST(SceneViewer, OutOfFileDescriptors) {
+#if defined(__SANITIZE_ADDRESS__)
+  // The sanitizer build has UBSan too, whose vptr check tests memory through a pipe: in a
+  // process with no descriptor left it reports every virtual call as an invalid vptr.
+  GTEST_SKIP() << "UBSan needs a free file descriptor; this test runs in the release and TSan builds";
+#endif
   FdLimitServer server;
   int port = 0;
   ASSERT_EQ(std::sscanf(server.ask("").c_str(), "port %d", &port), 1);
