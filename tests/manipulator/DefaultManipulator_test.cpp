@@ -431,6 +431,7 @@ TEST_F(ManipulatorTest, ARateFromTheQMotorConfigIsThePeriodTheServoControlIntegr
   std::filesystem::remove_all(dir);
   Puma560 puma("leader");
   ASSERT_TRUE(puma.waitForCycles(10));
+  puma.stop();  // the servo thread's own data is read once it has ended
   EXPECT_EQ(puma.getPeriod(), 0.002);
   EXPECT_EQ(puma.getDefaultPositionControl().getPeriod(), 0.002);
   EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;

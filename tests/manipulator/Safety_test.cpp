@@ -211,13 +211,21 @@ TEST_F(SafetyTest, AfterAFaultTheDampedHoldStopsTheArmThenTheBrakesEngage) {
   EXPECT_GE(cycles - restCycle, 45);
   EXPECT_LE(peakTorque, 1.0) << "the hold stays within the torque limits";
   simClock().resume();
+  ASSERT_TRUE(ObjectManager::waitForShutdown(30));  // the manager is done with every object
   ObjectManager::setShutdownTimeout(5);
 }
 
-// A Puma whose destructor records the state its servo loop published last (the loop has stopped).
-class RecordingPuma : public Puma560 {
+// A user's arm class as the docs say to write one: a DefaultManipulator (a Puma 560 model) that
+// starts its loop last in its constructor and stops it first in its destructor, then records the
+// state its servo loop published last.
+class RecordingPuma : public DefaultManipulator {
  public:
-  RecordingPuma(JointVector& velocity, bool& power) : velocity_(velocity), power_(power) {}
+  RecordingPuma(JointVector& velocity, bool& power)
+      : DefaultManipulator("", [](const Transform& base) { return std::make_unique<Puma560Model>(0.67183, base); }),
+        velocity_(velocity),
+        power_(power) {
+    startControlLoop();
+  }
   ~RecordingPuma() override {
     stopControlLoop();
     velocity_ = getJointVelocity();

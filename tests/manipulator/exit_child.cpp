@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstring>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -49,9 +50,10 @@ int main(int argc, char* argv[]) {
   tragen.move(q);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   std::cout << "ready" << std::endl;
-  Runaway runaway(mode == "throw");
+  std::optional<Runaway> runaway;  // destroyed only after the shutdown manager is done with it
   if (mode == "fault" || mode == "throw") {
-    puma.setServoControl(runaway);
+    runaway.emplace(mode == "throw");
+    puma.setServoControl(*runaway);
     rp::ObjectManager::waitForShutdown(20);
   } else if (mode == "signal") {
     while (!rp::ObjectManager::isShutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
