@@ -66,11 +66,6 @@ constexpr double kRestDuration = 0.05;  // [s] at rest before the power goes off
 constexpr double kShutdownTimeout = 3.0;  // [s] longest damped hold
 constexpr int kMaxCatchUpSteps = 1000;    // longest stall the simulation integrates, in periods
 
-bool allFinite(const JointVector& v) {
-  for (int i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v(i))) return false;
-  return true;
-}
 int firstNonFinite(const JointVector& v) {
   for (int i = 0; i < v.size(); ++i)
     if (!std::isfinite(v(i))) return i;
@@ -139,8 +134,7 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
 }
 
 DefaultManipulator::~DefaultManipulator() {
-  holdUntilSafe();
-  stopControlLoop();
+  stopControlLoop();  // holds a powered arm first (beforeControlLoopStops())
   if (TrajectoryGenerator* g = generator_.exchange(nullptr)) {
     disconnectGenerator(*g);
     g->detach(*this);
@@ -507,7 +501,7 @@ void DefaultManipulator::control() {
     // Re-check: a generator being released is not called any more.
     try {
       if (generator_.load(std::memory_order_seq_cst) == generator && generator->getCurrentSetpoint(t, setpoint_)) {
-        if (allFinite(setpoint_.position) && allFinite(setpoint_.velocity) && allFinite(setpoint_.acceleration)) {
+        if (setpoint_.position.allFinite() && setpoint_.velocity.allFinite() && setpoint_.acceleration.allFinite()) {
           hold_ = setpoint_.position;
         } else {
           fault("the trajectory generator gave a setpoint that is not a number");
@@ -562,14 +556,7 @@ void DefaultManipulator::control() {
 
   // 4. The command is saturated at the torque limits (control and gravity together), then the
   // position and velocity limits are checked.
-  saturatedJoints_ = 0;
-  for (int i = 0; i < n; ++i) {
-    const double limit = model_->getTorqueLimit()(i);
-    if (std::abs(tau_(i)) > limit) {
-      tau_(i) = std::copysign(limit, tau_(i));
-      saturatedJoints_ += 1;
-    }
-  }
+  saturate();
   if (saturatedJoints_ > 0 && power_) saturatedCycles_.fetch_add(1, std::memory_order_relaxed);
   if (power_ && phase == 0) checkLimits();
 
@@ -630,8 +617,18 @@ void DefaultManipulator::violation(const char* what, int joint, double value, do
   fault("joint %d %s %.6g %s exceeds the limit %.6g %s", joint + 1, what, value, unit, limit, unit);
   // Damped hold from this very cycle.
   holdTorque();
-  for (int i = 0; i < tau_.size(); ++i)
-    tau_(i) = std::clamp(tau_(i), -model_->getTorqueLimit()(i), model_->getTorqueLimit()(i));
+  saturate();
+}
+
+void DefaultManipulator::saturate() noexcept {
+  saturatedJoints_ = 0;
+  for (int i = 0; i < tau_.size(); ++i) {
+    const double limit = model_->getTorqueLimit()(i);
+    if (std::abs(tau_(i)) > limit) {
+      tau_(i) = std::copysign(limit, tau_(i));
+      saturatedJoints_ += 1;
+    }
+  }
 }
 
 void DefaultManipulator::fault(const char* format, ...) noexcept {

@@ -22,6 +22,7 @@
 namespace rp {
 namespace {
 
+using test::ConstantTorque;
 using test::simClock;
 using ManipulatorTest = test::SimulatedArmTest;
 
@@ -119,21 +120,6 @@ TEST_F(ManipulatorTest, GravityCompensationAloneHoldsRandomPosesAtRest) {
 
 // Step and trajectory tracking with derived bounds: Tracking_test.cpp.
 
-// Outputs a constant torque on one joint.
-class ConstantTorque : public ServoControl {
- public:
-  ConstantTorque(int joint, double torque) : joint_(joint), torque_(torque) {}
-  ~ConstantTorque() override { releaseFromManipulator(); }
-  void calculate() override {
-    Vector<6> t;
-    t(joint_) = torque_;
-    d_manipulator->setControlOutput(t);
-  }
-
- private:
-  int joint_;
-  double torque_;
-};
 
 // A command above the torque limit is saturated, not a fault: Safety_test.cpp.
 

@@ -58,20 +58,21 @@ TEST(ExitPath, AReturnWhileTheArmMovesExitsWithTheProgramsStatus) {
   EXPECT_FALSE(has(r, "system shutdown")) << r.output;
 }
 
-TEST(ExitPath, AFaultEndsWithStatus3AfterTheShutdownCompleted) {
-  const ChildRun r = runChild("fault");
+// A run ended by a system shutdown with `reason`: status 3, the shutdown completed, and the
+// program said so instead of "done".
+void expectShutdownExit(const std::string& mode, const std::string& reason) {
+  const ChildRun r = runChild(mode);
   EXPECT_EQ(r.status, RoboticPlatform::kExitAfterShutdown) << r.output;
-  EXPECT_TRUE(has(r, "rp: system shutdown: puma: joint 1 velocity")) << r.output;
+  EXPECT_TRUE(has(r, "rp: system shutdown: puma: " + reason)) << r.output;
   EXPECT_TRUE(has(r, "rp: system shutdown complete")) << r.output;
   EXPECT_TRUE(has(r, "exit_child: stopped by a system shutdown")) << r.output;
   EXPECT_FALSE(has(r, "exit_child: done")) << r.output;
 }
 
+TEST(ExitPath, AFaultEndsWithStatus3AfterTheShutdownCompleted) { expectShutdownExit("fault", "joint 1 velocity"); }
+
 TEST(ExitPath, AnExceptionInCalculateEndsWithStatus3AndItsMessage) {
-  const ChildRun r = runChild("throw");
-  EXPECT_EQ(r.status, RoboticPlatform::kExitAfterShutdown) << r.output;
-  EXPECT_TRUE(has(r, "rp: system shutdown: puma: the servo control threw: encoder cable cut")) << r.output;
-  EXPECT_TRUE(has(r, "rp: system shutdown complete")) << r.output;
+  expectShutdownExit("throw", "the servo control threw: encoder cable cut");
 }
 
 TEST(ExitPath, SigintAndSigtermAlwaysCompleteTheShutdownAndExit128PlusTheSignal) {

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "ChildProcess.hpp"
+#include "SimulatedArmTest.hpp"
 #include "rp/RoboticPlatform.hpp"
 
 namespace rp {
@@ -91,25 +92,6 @@ class StallOnce : public ServoControl {
   DefaultPositionControl& inner_;
 };
 
-// Joint 1 at a constant 0.5 rad/s from where the arm is.
-class Ramp : public TrajectoryGenerator {
- public:
-  explicit Ramp(const JointVector& start) : start_(start) {}
-  ~Ramp() override { releaseFromManipulators(); }
-  bool getCurrentSetpoint(double time, Setpoint& sp) override {
-    if (t0_ < 0) t0_ = time;
-    sp.position = start_;
-    sp.position(0) += 0.5 * std::min(time - t0_, 1.0);
-    sp.velocity.setZero();
-    sp.velocity(0) = time - t0_ < 1.0 ? 0.5 : 0.0;
-    return true;
-  }
-
- private:
-  JointVector start_;
-  double t0_ = -1;
-};
-
 TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
   // 100 ms without a cycle while joint 1 moves at 0.5 rad/s: the encoders moved 0.05 rad, which
   // divided by one period (1 ms) read as 50 rad/s and tripped the 2 rad/s velocity limit. The
@@ -119,7 +101,7 @@ TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
   {
     Puma560 puma("leader");
     StallOnce stall(puma.getDefaultPositionControl());
-    Ramp ramp(puma.getJointPosition());
+    test::JointRamp ramp(0, 0.5, 1.0);  // joint 1 at 0.5 rad/s for 1 s
     puma.setServoControl(stall);
     puma.setTrajectoryGenerator(ramp);
     for (int i = 0; i < 3000 && stall.calls.load() < 1000; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));

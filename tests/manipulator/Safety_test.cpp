@@ -21,30 +21,10 @@
 namespace rp {
 namespace {
 
+using test::ConstantTorque;
+using test::JointRamp;
 using test::simClock;
 using SafetyTest = test::SimulatedArmTest;
-
-// Outputs a constant torque on one joint (for the first `cycles` cycles if given, then the
-// default position control's output).
-class ConstantTorque : public ServoControl {
- public:
-  ConstantTorque(int joint, double torque, int cycles = -1) : joint_(joint), torque_(torque), cycles_(cycles) {}
-  ~ConstantTorque() override { releaseFromManipulator(); }
-  void calculate() override {
-    ++calls;
-    auto& m = dynamic_cast<DefaultManipulator&>(*d_manipulator);
-    if (cycles_ >= 0 && calls > cycles_) return m.getDefaultPositionControl().calculate();
-    JointVector t = JointVector::Zero(m.getNumberOfJoints());
-    t(joint_) = torque_;
-    m.setControlOutput(t);
-  }
-  std::atomic<int> calls{0};
-
- private:
-  int joint_;
-  double torque_;
-  int cycles_;
-};
 
 // A user's control that fails on its third call: a torque that is not a number, or a throw.
 class FailingControl : public ServoControl {
@@ -237,35 +217,13 @@ class RecordingPuma : public DefaultManipulator {
   bool& power_;
 };
 
-// Joint 1 at a constant speed from where the arm is.
-class JointRamp : public TrajectoryGenerator {
- public:
-  explicit JointRamp(double speed) : speed_(speed) {}
-  ~JointRamp() override { releaseFromManipulators(); }
-  bool getCurrentSetpoint(double time, Setpoint& sp) override {
-    if (t0_ < 0) {
-      t0_ = time;
-      start_ = sp.position;  // the hold position the manipulator filled in
-    }
-    sp.position = start_;
-    sp.position(0) += speed_ * (time - t0_);
-    sp.velocity.setZero();
-    sp.velocity(0) = speed_;
-    return true;
-  }
-
- private:
-  double speed_, t0_ = -1;
-  JointVector start_;
-};
-
 TEST_F(SafetyTest, DestroyingAMovingArmHoldsItUntilAtRestFirst) {
   // Before, the most-derived destructor stopped the loop at once: the power went off with the arm
   // moving. Now stopControlLoop() first runs the damped hold until the arm is at rest.
   JointVector velocity;
   bool power = true;
   {
-    JointRamp ramp(0.8);
+    JointRamp ramp(0, 0.8);
     simClock().pause();
     RecordingPuma puma(velocity, power);
     puma.setTrajectoryGenerator(ramp);

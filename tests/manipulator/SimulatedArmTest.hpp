@@ -1,8 +1,13 @@
-// Shared by the manipulator tests: the platform's simulated clock and a fixture that runs each
-// test in simulation mode on it with a fresh configuration and no pending shutdown.
+// Shared by the manipulator tests: the platform's simulated clock, a fixture that runs each test
+// in simulation mode on it with a fresh configuration and no pending shutdown, a constant-torque
+// servo control and a joint ramp.
 #pragma once
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <limits>
 
 #include "rp/RoboticPlatform.hpp"
 
@@ -22,6 +27,54 @@ class SimulatedArmTest : public ::testing::Test {
     simClock().resume();
   }
   void TearDown() override { simClock().resume(); }
+};
+
+// Outputs a constant torque on one joint (for the first `cycles` cycles if given, then the
+// default position control's output); counts its calls.
+class ConstantTorque : public ServoControl {
+ public:
+  ConstantTorque(int joint, double torque, int cycles = -1) : joint_(joint), torque_(torque), cycles_(cycles) {}
+  ~ConstantTorque() override { releaseFromManipulator(); }
+  void calculate() override {
+    ++calls;
+    auto& m = dynamic_cast<DefaultManipulator&>(*d_manipulator);
+    if (cycles_ >= 0 && calls > cycles_) return m.getDefaultPositionControl().calculate();
+    JointVector t = JointVector::Zero(m.getNumberOfJoints());
+    t(joint_) = torque_;
+    m.setControlOutput(t);
+  }
+  std::atomic<int> calls{0};
+
+ private:
+  int joint_;
+  double torque_;
+  int cycles_;
+};
+
+// Moves one joint at a constant speed for `duration` seconds (for ever by default) from the hold
+// position the manipulator gives at the first call, then holds there.
+class JointRamp : public TrajectoryGenerator {
+ public:
+  JointRamp(int joint, double speed, double duration = std::numeric_limits<double>::infinity())
+      : joint_(joint), speed_(speed), duration_(duration) {}
+  ~JointRamp() override { releaseFromManipulators(); }
+  bool getCurrentSetpoint(double time, Setpoint& sp) override {
+    if (t0_ < 0) {
+      t0_ = time;
+      start_ = sp.position;  // the hold position the manipulator filled in
+    }
+    const double moving = std::min(time - t0_, duration_);
+    sp.position = start_;
+    sp.position(joint_) += speed_ * moving;
+    sp.velocity.setZero();
+    sp.velocity(joint_) = time - t0_ < duration_ ? speed_ : 0.0;
+    return true;
+  }
+
+ private:
+  int joint_;
+  double speed_, duration_, t0_ = -1;
+  JointVector start_;
 };
 
 }  // namespace rp::test

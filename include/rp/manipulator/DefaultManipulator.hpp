@@ -173,6 +173,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   // requests the system shutdown; the first fault wins. Real-time safe.
   void fault(const char* format, ...) noexcept __attribute__((format(printf, 2, 3)));
   void holdTorque();
+  void saturate() noexcept;  // tau_ within the torque limits; saturatedJoints_ counts the joints
   void powerOffNow() noexcept;
   void finishCycle(double t, double dt);
   void holdUntilSafe();
