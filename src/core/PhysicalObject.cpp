@@ -3,10 +3,15 @@
 
 #include <cmath>
 #include <mutex>
+#include <stdexcept>
 
 #include "rp/core/RoboticPlatform.hpp"
 
 namespace rp {
+
+namespace {
+constexpr int kMaxMountDepth = 64;  // longest chain of connections followed
+}  // namespace
 
 struct PhysicalObject::Impl {
   mutable std::mutex mutex;
@@ -17,6 +22,16 @@ struct PhysicalObject::Impl {
   std::atomic<int> simulation{-1};
   std::atomic<int> display{static_cast<int>(DisplayMode::Solid)};
 };
+
+template <typename Undo>
+void PhysicalObject::changed(const Undo& undo) {
+  try {
+    physicalSetupChanged();
+  } catch (...) {
+    undo();
+    throw;
+  }
+}
 
 PhysicalObject::PhysicalObject(const std::string& name) : RoboticObject(name), pimpl_(std::make_unique<Impl>()) {
   const ConfigSection* section = configSection();
@@ -64,15 +79,46 @@ Model3D PhysicalObject::get3DModel() const {
 }
 
 void PhysicalObject::setConnection(PhysicalObject& mount, const std::string& frame) {
-  std::lock_guard<std::mutex> lock(pimpl_->mutex);
-  pimpl_->connection = &mount;
-  pimpl_->connectionFrame = frame;
+  // No cycles: the mount must not be this object nor carried by it.
+  const PhysicalObject* m = &mount;
+  for (int depth = 0; m != nullptr && depth < kMaxMountDepth; ++depth, m = m->getConnection()) {
+    if (m == this) {
+      throw std::invalid_argument("'" + getName() + "' cannot be mounted on '" + mount.getName() +
+                                  "': the connection would make a cycle");
+    }
+  }
+  PhysicalObject* oldMount = nullptr;
+  std::string oldFrame;
+  {
+    std::lock_guard<std::mutex> lock(pimpl_->mutex);
+    oldMount = pimpl_->connection;
+    oldFrame = pimpl_->connectionFrame;
+    pimpl_->connection = &mount;
+    pimpl_->connectionFrame = frame;
+  }
+  changed([&] {
+    std::lock_guard<std::mutex> lock(pimpl_->mutex);
+    pimpl_->connection = oldMount;
+    pimpl_->connectionFrame = oldFrame;
+  });
 }
 
 void PhysicalObject::clearConnection() {
-  std::lock_guard<std::mutex> lock(pimpl_->mutex);
-  pimpl_->connection = nullptr;
-  pimpl_->connectionFrame = "base";
+  PhysicalObject* oldMount = nullptr;
+  std::string oldFrame;
+  {
+    std::lock_guard<std::mutex> lock(pimpl_->mutex);
+    oldMount = pimpl_->connection;
+    oldFrame = pimpl_->connectionFrame;
+    pimpl_->connection = nullptr;
+    pimpl_->connectionFrame = "base";
+  }
+  if (oldMount == nullptr) return;
+  changed([&] {
+    std::lock_guard<std::mutex> lock(pimpl_->mutex);
+    pimpl_->connection = oldMount;
+    pimpl_->connectionFrame = oldFrame;
+  });
 }
 
 PhysicalObject* PhysicalObject::getConnection() const {
@@ -86,8 +132,18 @@ std::string PhysicalObject::getConnectionFrame() const {
 }
 
 void PhysicalObject::setTransform(const Transform& t) {
-  std::lock_guard<std::mutex> lock(pimpl_->mutex);
-  pimpl_->transform = t;
+  if (const std::string problem = rigidTransformError(t); !problem.empty())
+    throw std::invalid_argument("setTransform of '" + getName() + "': the pose " + problem);
+  Transform old;
+  {
+    std::lock_guard<std::mutex> lock(pimpl_->mutex);
+    old = pimpl_->transform;
+    pimpl_->transform = t;
+  }
+  changed([&] {
+    std::lock_guard<std::mutex> lock(pimpl_->mutex);
+    pimpl_->transform = old;
+  });
 }
 
 Transform PhysicalObject::getTransform() const {
@@ -95,8 +151,35 @@ Transform PhysicalObject::getTransform() const {
   return pimpl_->transform;
 }
 
-void PhysicalObject::setSimulationModeOn() { pimpl_->simulation = 1; }
-void PhysicalObject::setSimulationModeOff() { pimpl_->simulation = 0; }
+Transform PhysicalObject::getWorldTransform() const {
+  PhysicalObject* mount = nullptr;
+  std::string frame;
+  Transform own;
+  {
+    std::lock_guard<std::mutex> lock(pimpl_->mutex);
+    mount = pimpl_->connection;
+    frame = pimpl_->connectionFrame;
+    own = pimpl_->transform;
+  }
+  if (mount == nullptr) return own;
+  return Transform(mount->getFrameTransform(frame) * own);
+}
+
+Transform PhysicalObject::getFrameTransform(const std::string& frame) const {
+  if (frame != "base") throw std::invalid_argument("'" + getName() + "' has no frame '" + frame + "'");
+  return getWorldTransform();
+}
+
+void PhysicalObject::setSimulationModeOn() {
+  const int old = pimpl_->simulation.exchange(1);
+  changed([&] { pimpl_->simulation = old; });
+}
+
+void PhysicalObject::setSimulationModeOff() {
+  const int old = pimpl_->simulation.exchange(0);
+  changed([&] { pimpl_->simulation = old; });
+}
+
 
 bool PhysicalObject::isSimulationModeOn() const {
   if (RoboticPlatform::isSimulationModeForced()) return true;

@@ -73,32 +73,156 @@ int firstNonFinite(const JointVector& v) {
 }
 }  // namespace
 
-DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFactory& modelFactory)
-    : Manipulator(name), ControlProgram(name.empty() ? "manipulator" : name) {
-  setProgramName(getName());
-  model_ = modelFactory(getTransform());
-  if (!model_) throw std::invalid_argument("DefaultManipulator '" + getName() + "': no model");
-  if (!isSimulationModeOn()) {
+struct DefaultManipulator::Setup {
+  std::unique_ptr<ManipulatorModel> model;
+  std::unique_ptr<ManipulatorData> data;
+  std::unique_ptr<ManipulatorSimulation> sim;
+  std::unique_ptr<IoBoard> board;  // a new hardware connection (none: simulation, or keepBoard)
+  std::unique_ptr<Differentiator<JointVector>> velocity;
+  double countsPerRadian = 20000;
+  bool noHardware = false;  // simulation off, no hardware configured
+  bool keepBoard = false;   // the hardware stays: only the pose changed
+};
+
+std::unique_ptr<DefaultManipulator::Setup> DefaultManipulator::makeSetup(bool simulation, const Transform& base) const {
+  auto setup = std::make_unique<Setup>();
+  setup->model = modelFactory_(base);
+  if (!setup->model) throw std::invalid_argument("DefaultManipulator '" + getName() + "': no model");
+  if (!simulation) {
     const ConfigSection* section = configSection();
-    if (section == nullptr || !section->has("hwserver")) {
+    if (board_ != nullptr) {
+      setup->keepBoard = true;
+    } else if (section == nullptr || !section->has("hwserver")) {
       // No hardware: the arm stays unpowered until the program switches it to simulation
       // (setSimulationModeOn() right after the declaration, as the paper's Figure 23 does); see
       // control() and enableArmPower().
-      noHardware_.store(true);
+      setup->noHardware = true;
     } else {
-      if (section->has("countsPerRadian")) countsPerRadian_ = section->getNumbers("countsPerRadian").at(0);
-      board_ = std::make_unique<HwServerIoBoard>(section->getWord("hwserver"));  // throws IoException if absent
+      if (section->has("countsPerRadian")) setup->countsPerRadian = section->getNumbers("countsPerRadian").at(0);
+      setup->board = std::make_unique<HwServerIoBoard>(section->getWord("hwserver"));  // throws IoException if absent
+      setup->velocity = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
     }
   }
+  setup->data = std::make_unique<ManipulatorData>(*setup->model);
+  setup->sim = std::make_unique<ManipulatorSimulation>(*setup->model);
+  return setup;
+}
+
+void DefaultManipulator::install(Setup& setup) noexcept {
+  std::swap(model_, setup.model);
+  std::swap(data_, setup.data);
+  std::swap(sim_, setup.sim);
+  if (!setup.keepBoard) {
+    std::swap(board_, setup.board);
+    std::swap(velocity_, setup.velocity);
+    countsPerRadian_ = setup.countsPerRadian;
+  }
+  noHardware_.store(setup.noHardware, std::memory_order_relaxed);
+  noHardwareSince_ = -1;
+  usesHardware_.store(board_ != nullptr, std::memory_order_release);
+  modelView_.store(model_.get(), std::memory_order_release);
+}
+
+void DefaultManipulator::applySetup(Setup& setup) noexcept {
+  if (board_ != nullptr && !setup.keepBoard) writeOutputsOff();  // leaving this hardware: amplifiers off, 0 V
+  install(setup);
+  if (board_ != nullptr) {
+    // The hardware takes over: the arm is where its encoders say.
+    velocity_->reset();
+    if (!readHardware(getPeriod())) return ioFailure("reading the encoders", 0);
+    (void)velocity_->differentiate(q_);
+    qd_.setZero();
+  } else {
+    // A simulation takes over from the joint state the arm had.
+    sim_->setState(q_, qd_);
+    sim_->setBrakes(!power_);
+    applyWrenches(static_cast<int>(q_.size()));
+  }
+  hold_ = q_;
+  setpoint_.position = q_;
+  activeControl_ = nullptr;  // the servo control starts afresh (activate())
+  lastCycleTime_ = -1;       // nothing to catch up across the change
+}
+
+void DefaultManipulator::applyWrenches(int n) {
+  Vector<3> point;
+  Vector<6> wrench;
+  for (int k = 0; k <= n; ++k) {
+    const double* slot = wrench_->snapshot + k * WrenchBox::kSlot;
+    for (int i = 0; i < 3; ++i) point(i) = slot[i];
+    for (int i = 0; i < 6; ++i) wrench(i) = slot[3 + i];
+    if (k == 0) {
+      sim_->setExternalWrench(wrench);
+    } else {
+      sim_->setExternalLinkWrench(k, point, wrench);
+    }
+  }
+}
+
+void DefaultManipulator::physicalSetupChanged() {
+  if (modelView_.load() == nullptr) return;  // the constructor has not built the parts yet
+  std::lock_guard<std::mutex> lock(setupMutex_);
+  const bool simulation = isSimulationModeOn();
+  const Transform base = getWorldTransform();
+  if (simulation == builtForSimulation_ && base == builtBase_) return;
+  if (shutdownPhase_.load() != 0 || loopEnded_.load()) {
+    throw std::logic_error("manipulator '" + getName() +
+                           "': the pose, mount and simulation mode cannot change during or after a shutdown");
+  }
+  if (generator_.load() != nullptr || servoControl_.load() != defaultControl_.get()) {
+    throw std::logic_error("manipulator '" + getName() +
+                           "': set the pose, mount and simulation mode before a trajectory generator or a servo "
+                           "control of the program drives the arm (clear them first)");
+  }
+  if (!simulation && builtForSimulation_) {
+    const ConfigSection* section = configSection();
+    if (section == nullptr || !section->has("hwserver")) throw std::runtime_error(noHardwareMessage());
+  }
+  std::unique_ptr<Setup> setup = makeSetup(simulation, base);  // may throw: nothing changed yet
+  if (!isRunning()) {
+    applySetup(*setup);  // no servo thread (a derived constructor): apply here
+    for (int i = 0; i < initial_.n; ++i) initial_.q[i] = initial_.qdes[i] = q_(i);
+  } else {
+    // The servo thread takes it between two cycles; a paused simulated clock is stepped until it has.
+    Setup* handed = setup.get();
+    appliedSetup_.store(nullptr);
+    pendingSetup_.store(handed, std::memory_order_release);
+    auto* simulated = dynamic_cast<SimulatedClock*>(&getClock());
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    while (appliedSetup_.load(std::memory_order_acquire) != handed) {
+      if (!isRunning() || loopEnded_.load() || std::chrono::steady_clock::now() > deadline) {
+        Setup* expected = handed;
+        if (pendingSetup_.compare_exchange_strong(expected, nullptr)) {
+          throw std::runtime_error("manipulator '" + getName() +
+                                   "': the servo loop did not take the change of pose or simulation mode");
+        }
+        // Taken just now: it is being applied.
+      }
+      if (simulated != nullptr && simulated->isPaused()) {
+        (void)runCycles(1, 1.0);  // a cycle already under way when the clock stopped may not take it
+      } else {
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+      }
+    }
+  }
+  builtForSimulation_ = simulation;
+  builtBase_ = base;
+  retiredModels_.push_back(std::move(setup->model));  // the old parts (outputs already off)
+}
+
+DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFactory& modelFactory)
+    : Manipulator(name), ControlProgram(name.empty() ? "manipulator" : name), modelFactory_(modelFactory) {
+  setProgramName(getName());
+  builtForSimulation_ = isSimulationModeOn();
+  builtBase_ = getWorldTransform();
+  std::unique_ptr<Setup> setup = makeSetup(builtForSimulation_, builtBase_);
+  install(*setup);
   const int n = model_->getNumberOfJoints();
-  data_ = std::make_unique<ManipulatorData>(*model_);
-  sim_ = std::make_unique<ManipulatorSimulation>(*model_);
   wrench_ = std::make_unique<WrenchBox>();
   for (JointVector* v : {&q_, &qd_, &tau_, &gravity_, &hold_}) v->setZero(n);
   for (JointVector* v : {&setpoint_.position, &setpoint_.velocity, &setpoint_.acceleration}) v->setZero(n);
   q_ = sim_->getPosition();
   if (board_) {
-    velocity_ = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
     if (!readHardware(getPeriod())) {
       throw std::runtime_error("manipulator '" + getName() + "': cannot read the joints: " + board_->lastError());
     }
@@ -205,23 +329,25 @@ bool DefaultManipulator::isArmPowerOn() const {
 
 Transform DefaultManipulator::getEndEffectorTransform() const {
   if (inServoThread()) return forwardKinematics(*model_, *data_, q_);
-  ManipulatorData data(*model_);
-  return forwardKinematics(*model_, data, getJointPosition());
+  const ManipulatorModel& model = getModel();
+  ManipulatorData data(model);
+  return forwardKinematics(model, data, getJointPosition());
 }
 
 void DefaultManipulator::endEffectorForceToJointTorque(const Eigen::Ref<const Eigen::VectorXd>& q,
                                                        const Eigen::Ref<const Eigen::VectorXd>& force,
                                                        Eigen::Ref<Eigen::VectorXd> torque) const {
-  if (q.size() != model_->getNumberOfJoints()) {
+  const ManipulatorModel& model = inServoThread() ? *model_ : getModel();
+  if (q.size() != model.getNumberOfJoints()) {
     throw MathException("endEffectorForceToJointTorque: " + std::to_string(q.size()) + " joint positions for " +
-                        std::to_string(model_->getNumberOfJoints()) + " joints");
+                        std::to_string(model.getNumberOfJoints()) + " joints");
   }
   const JointVector qv = q;
   if (inServoThread()) {
-    rp::endEffectorForceToJointTorque(*model_, *data_, qv, force, torque, ReferenceFrame::Base);
+    rp::endEffectorForceToJointTorque(model, *data_, qv, force, torque, ReferenceFrame::Base);
   } else {
-    ManipulatorData data(*model_);
-    rp::endEffectorForceToJointTorque(*model_, data, qv, force, torque, ReferenceFrame::Base);
+    ManipulatorData data(model);
+    rp::endEffectorForceToJointTorque(model, data, qv, force, torque, ReferenceFrame::Base);
   }
 }
 
@@ -281,7 +407,7 @@ void DefaultManipulator::setZeroGravityModeOff() {
 void DefaultManipulator::applyExternalWrench(const Vector<6>& wrench) { wrench_->write(0, Vector<3>(), wrench); }
 
 void DefaultManipulator::applyExternalWrench(int link, const Vector<3>& point, const Vector<6>& wrench) {
-  const int n = model_->getNumberOfJoints();
+  const int n = initial_.n;
   if (link < 1 || link > n) {
     throw std::out_of_range(getName() + ": applyExternalWrench: link " + std::to_string(link) + " is not in 1.." +
                             std::to_string(n));
@@ -371,7 +497,7 @@ void DefaultManipulator::writeHardware() {
 void DefaultManipulator::writeOutputsOff() noexcept {
   // Every output is written even if one fails: the amplifiers off first, then 0 V.
   (void)board_->writeDigitalOutput(0, false);
-  for (int i = 0; i < model_->getNumberOfJoints(); ++i) (void)board_->writeAnalogOutput(i, 0.0);
+  for (int i = 0; i < initial_.n; ++i) (void)board_->writeAnalogOutput(i, 0.0);
 }
 
 void DefaultManipulator::ioFailure(const char* what, int line) {
@@ -421,6 +547,14 @@ void DefaultManipulator::control() {
   const double dt = getPeriod();
   const int n = model_->getNumberOfJoints();
 
+  // A change of pose or simulation mode (physicalSetupChanged()) takes effect between cycles.
+  if (pendingSetup_.load(std::memory_order_relaxed) != nullptr) {
+    if (Setup* setup = pendingSetup_.exchange(nullptr, std::memory_order_acq_rel)) {
+      applySetup(*setup);
+      appliedSetup_.store(setup, std::memory_order_release);
+    }
+  }
+
   // 0. An arm with no hardware waits, unpowered, for setSimulationModeOn(); half a second
   // without it is a fault (a program that forgot it, or -nosim without the arm's hardware).
   if (noHardware_.load(std::memory_order_relaxed)) {
@@ -459,20 +593,7 @@ void DefaultManipulator::control() {
       const int skipped = std::min(kMaxCatchUpSteps, static_cast<int>(std::lround((t - lastCycleTime_) / dt)) - 1);
       for (int k = 0; k < skipped; ++k) sim_->step(tau_, dt);
     }
-    if (wrench_->read(n + 1)) {
-      Vector<3> point;
-      Vector<6> wrench;
-      for (int k = 0; k <= n; ++k) {
-        const double* slot = wrench_->snapshot + k * WrenchBox::kSlot;
-        for (int i = 0; i < 3; ++i) point(i) = slot[i];
-        for (int i = 0; i < 6; ++i) wrench(i) = slot[3 + i];
-        if (k == 0) {
-          sim_->setExternalWrench(wrench);
-        } else {
-          sim_->setExternalLinkWrench(k, point, wrench);
-        }
-      }
-    }
+    if (wrench_->read(n + 1)) applyWrenches(n);
     q_ = sim_->getPosition();
     qd_ = sim_->getVelocity();
   }
@@ -491,7 +612,9 @@ void DefaultManipulator::control() {
   // holds the arm where it is in this cycle: bumpless, never back to a stale pose.
   const bool zeroG = zeroGravity_.load(std::memory_order_relaxed);
   const bool controlChanges = servoControl_.load(std::memory_order_acquire) != activeControl_;
-  if (!power_ || zeroG || controlChanges || holdHere_.exchange(false, std::memory_order_acq_rel)) hold_ = q_;
+  // (The request is taken in every cycle: one left pending would move the hold a cycle later.)
+  const bool holdRequested = holdHere_.exchange(false, std::memory_order_acq_rel);
+  if (!power_ || zeroG || controlChanges || holdRequested) hold_ = q_;
   setpoint_.position = hold_;
   setpoint_.velocity.setZero();
   setpoint_.acceleration.setZero();
@@ -679,7 +802,7 @@ void DefaultManipulator::publish() {
 
 Model3D DefaultManipulator::get3DModel() const {
   Model3D m;
-  const int n = model_->getNumberOfJoints();
+  const int n = initial_.n;
   for (int i = 1; i <= n; ++i) m.frames.push_back("link" + std::to_string(i));
   m.frames.push_back("endEffector");
   Shape base;
@@ -700,7 +823,7 @@ Model3D DefaultManipulator::get3DModel() const {
 
 ControlPanel DefaultManipulator::getControlPanel() const {
   ControlPanel panel = Manipulator::getControlPanel();
-  const int n = model_->getNumberOfJoints();
+  const int n = initial_.n;
   auto field = [&](const char* name, const char* label, const char* unit, int index) {
     ControlPanelField f;
     f.name = name;

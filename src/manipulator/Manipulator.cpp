@@ -2,9 +2,12 @@
 #include "rp/manipulator/Manipulator.hpp"
 
 #include <algorithm>
+#include <cstdlib>
+#include <stdexcept>
 
 #include "rp/control/ServoControl.hpp"
 #include "rp/core/ObjectManager.hpp"
+#include "rp/model/Kinematics.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
 
 namespace rp {
@@ -15,6 +18,24 @@ Manipulator::~Manipulator() {
     if (control->d_manipulator == this) control->d_manipulator = nullptr;
   }
   for (TrajectoryGenerator* generator : om.getDerivedObjects<TrajectoryGenerator>()) disconnectGenerator(*generator);
+}
+
+Transform Manipulator::getFrameTransform(const std::string& frame) const {
+  const ManipulatorModel& model = getModel();
+  const int n = model.getNumberOfJoints();
+  if (frame == "base") return model.getBaseTransform();
+  int link = 0;
+  if (frame != "endEffector") {
+    char* end = nullptr;
+    const long k = frame.rfind("link", 0) == 0 && frame.size() > 4 ? std::strtol(frame.c_str() + 4, &end, 10) : 0;
+    if (end == nullptr || *end != '\0' || k < 1 || k > n)
+      throw std::invalid_argument("manipulator '" + getName() + "' has no frame '" + frame + "' (base, link1..link" +
+                                  std::to_string(n) + ", endEffector)");
+    link = static_cast<int>(k);
+  }
+  ManipulatorData data(model);
+  const Transform endEffector = forwardKinematics(model, data, getJointPosition());
+  return link == 0 ? endEffector : data.linkTransforms[static_cast<std::size_t>(link - 1)];
 }
 
 void Manipulator::connectGenerator(TrajectoryGenerator& generator) {

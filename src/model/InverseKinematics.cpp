@@ -58,22 +58,6 @@ void dampedStep(const Jacobian& J, const Vector6& e, double lambda, bool positio
 
 }  // namespace
 
-std::string rigidTransformError(const Transform& pose, double tolerance) {
-  if (!pose.allFinite()) return "has an element that is not a finite number";
-  if (pose(3, 0) != 0 || pose(3, 1) != 0 || pose(3, 2) != 0 || pose(3, 3) != 1) return "has a last row other than 0 0 0 1";
-  const Eigen::Matrix3d R = pose.topLeftCorner<3, 3>();
-  const double deviation = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  if (!(deviation <= tolerance)) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf,
-                  "has a rotation block that is not orthonormal (R^T R differs from I by %.3g; at most %.3g)", deviation,
-                  tolerance);
-    return buf;
-  }
-  if (R.determinant() <= 0) return "has a rotation block that is a reflection (determinant -1), not a rotation";
-  return {};
-}
-
 IkStatus inverseKinematics(const ManipulatorModel& model, ManipulatorData& data, const Transform& target,
                            const JointVector& seed, JointVector& q, const IkOptions& options) {
   const int n = model.getNumberOfJoints();

@@ -375,6 +375,89 @@ TEST_F(ManipulatorTest, ReleasingAServoControlHoldsTheArmWhereItIsNotWhereItWas)
   EXPECT_LT((now - released).norm(), 0.25 * (released - before).norm()) << "held near where it was released";
 }
 
+TEST_F(ManipulatorTest, ReleasingATrajectoryGeneratorMidMotionHoldsTheArmWhereItIs) {
+  // A ramp moves joint 1 at 0.5 rad/s; released after 1 s (cleared, or destroyed), the default
+  // control holds the arm where it is at that cycle: not back at the start, not on to a target.
+  Puma560 puma;
+  simClock().pause();
+  const double start = puma.getJointPosition()(0);
+  for (const bool destroy : {false, true}) {
+    double atRelease = 0;
+    {
+      test::JointRamp ramp(0, 0.5);
+      puma.setTrajectoryGenerator(ramp);
+      ASSERT_TRUE(puma.runCycles(1000));
+      atRelease = puma.getJointPosition()(0);
+      if (!destroy) puma.clearTrajectoryGenerator();
+    }
+    ASSERT_TRUE(puma.runCycles(1500));
+    const double now = puma.getJointPosition()(0);
+    EXPECT_GT(std::abs(atRelease - start), 0.3) << "the ramp moved the joint";
+    EXPECT_NEAR(now, atRelease, 0.02) << (destroy ? "destroyed" : "cleared") << ": held where it was released";
+    EXPECT_LT(std::abs(puma.getJointVelocity()(0)), 1e-3) << "and at rest";
+  }
+  simClock().resume();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, ATrajectoryGeneratorAndAServoControlTakeOverFromWhereTheArmIs) {
+  // Each hand-over gives the newcomer, in its first cycle, a setpoint at the arm's position then:
+  // a generator starts from it, a servo control set while the arm was moved holds it there.
+  struct FirstSetpoint : TrajectoryGenerator {
+    ~FirstSetpoint() override { releaseFromManipulators(); }
+    bool getCurrentSetpoint(double, Setpoint& sp) override {
+      if (first.size() == 0) first = sp.position;
+      return false;  // hold
+    }
+    JointVector first;
+  };
+  struct Tracker : ServoControl {  // PD on the setpoint; records the first one it sees
+    ~Tracker() override { releaseFromManipulator(); }
+    void calculate() override {
+      Manipulator& m = *d_manipulator;
+      if (first.size() == 0) {
+        first = m.getSetpoint().position;
+        qAtFirst = m.getJointPosition();
+      }
+      const JointVector tau = 400.0 * (m.getSetpoint().position - m.getJointPosition()) - 40.0 * m.getJointVelocity();
+      m.setControlOutput(tau);
+    }
+    JointVector first, qAtFirst;
+  };
+  Puma560 puma;
+  simClock().pause();
+  // Zero-gravity mode and a push move the arm away from where the default control held it.
+  puma.setZeroGravityModeOn();
+  Vector<6> push;
+  push(0) = 30;
+  puma.applyExternalWrench(push);
+  ASSERT_TRUE(puma.runCycles(600));
+  puma.clearExternalWrench();
+  Tracker tracker;
+  puma.setServoControl(tracker);
+  puma.setZeroGravityModeOff();
+  ASSERT_TRUE(puma.runCycles(2));
+  const JointVector held = tracker.qAtFirst;
+  ASSERT_EQ(tracker.first.size(), 6);
+  EXPECT_LT((tracker.first - held).cwiseAbs().maxCoeff(), 1e-12) << "the new control's first setpoint is where the arm is";
+  EXPECT_GT((held - puma.getModel().getHomePosition()).cwiseAbs().maxCoeff(), 0.02) << "the push moved the arm";
+
+  FirstSetpoint generator;
+  puma.setTrajectoryGenerator(generator);
+  ASSERT_TRUE(puma.runCycles(2));
+  ASSERT_EQ(generator.first.size(), 6);
+  EXPECT_LT((generator.first - held).cwiseAbs().maxCoeff(), 1e-12) << "the generator starts where the arm was held";
+  ASSERT_TRUE(puma.runCycles(1000));
+  // The arm was still coasting when the control took over: it stops near there (a stale hold
+  // would pull it back toward the home position instead).
+  const JointVector home = puma.getModel().getHomePosition();
+  EXPECT_LT((puma.getJointPosition() - held).norm(), 0.5 * (held - home).norm()) << "held near the take-over";
+  puma.clearTrajectoryGenerator();
+  puma.releaseServoControl(tracker);
+  simClock().resume();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
 TEST_F(ManipulatorTest, WithoutHardwareAnArmWaitsUnpoweredForSimulationModeOn) {
   // The paper's Figure 23 under -nosim: `Puma560 pumaSimulated; pumaSimulated.setSimulationModeOn();`
   // The declaration used to throw (no hardware configured); now the switch takes effect.

@@ -75,9 +75,14 @@ class PhysicalObject : public RoboticObject {
   /// Mounts this object on another one (e.g. a gripper on an end-effector frame).
   /// @param[in] mount  the object carrying this one (must outlive the connection)
   /// @param[in] frame  frame of `mount` this object is attached to (`base` for its base)
+  /// @throws std::invalid_argument if the connection would make a cycle (the object itself, or
+  ///         an object mounted on it)
+  /// @throws anything the object's physicalSetupChanged() throws; the connection is then unchanged
   /// Real-time safe: no.
   void setConnection(PhysicalObject& mount, const std::string& frame = "base");
-  /// Removes the connection: the pose is again relative to the world. Real-time safe: no.
+  /// Removes the connection: the pose is again relative to the world.
+  /// @throws anything the object's physicalSetupChanged() throws; the connection is then unchanged
+  /// Real-time safe: no.
   void clearConnection();
   /// The object this one is mounted on, or nullptr.
   PhysicalObject* getConnection() const;
@@ -86,14 +91,31 @@ class PhysicalObject : public RoboticObject {
 
   /// Sets the pose relative to the world, or to the mounting frame if connected.
   /// @param[in] t  pose [m]
+  /// @throws std::invalid_argument if `t` is not a rigid transform
+  /// @throws anything the object's physicalSetupChanged() throws; the pose is then unchanged
   /// Real-time safe: no.
   void setTransform(const Transform& t);
   /// The pose set by setTransform() or rp.cfg [m]. Real-time safe: no.
   Transform getTransform() const;
+  /// The pose of this object's base in the world [m]: getTransform() composed with the pose of
+  /// the mounting frame (through the chain of connections, evaluated now).
+  /// Real-time safe: no.
+  Transform getWorldTransform() const;
+  /// The world pose of one of this object's frames (those its 3D model names) [m]. The default
+  /// knows only `base`, the pose of getWorldTransform(); classes with moving frames
+  /// (manipulators) override it.
+  /// @param[in] frame  frame name
+  /// @throws std::invalid_argument if the object has no such frame
+  /// Real-time safe: no.
+  virtual Transform getFrameTransform(const std::string& frame) const;
 
-  /// Locks the object into simulation mode (no hardware I/O). Real-time safe: no.
+  /// Locks the object into simulation mode (no hardware I/O).
+  /// @throws anything the object's physicalSetupChanged() throws; the mode is then unchanged
+  /// Real-time safe: no.
   void setSimulationModeOn();
-  /// Uses the hardware (unless the platform runs with `-sim`). Real-time safe: no.
+  /// Uses the hardware (unless the platform runs with `-sim`).
+  /// @throws anything the object's physicalSetupChanged() throws; the mode is then unchanged
+  /// Real-time safe: no.
   void setSimulationModeOff();
   /// Whether the object simulates its hardware: its own setting if given (code or rp.cfg),
   /// otherwise the platform's (`-sim`/`-nosim`, default on); `-sim` forces it on.
@@ -112,7 +134,19 @@ class PhysicalObject : public RoboticObject {
   /// The display mode (default Solid).
   DisplayMode getDisplayMode() const;
 
+ protected:
+  /// Called after setTransform(), setConnection(), clearConnection(), setSimulationModeOn() and
+  /// setSimulationModeOff() changed the object: a class that built something from its pose or
+  /// its simulation mode (a manipulator's model, its hardware connection) applies the change
+  /// here. If it throws, the change is undone and the exception reaches the caller. The default
+  /// does nothing. Not called from PhysicalObject's constructor (rp.cfg's settings are there
+  /// before any derived part is built).
+  virtual void physicalSetupChanged() {}
+
  private:
+  template <typename Undo>
+  void changed(const Undo& undo);  // calls physicalSetupChanged(); undo() and rethrow if it throws
+
   struct Impl;
   std::unique_ptr<Impl> pimpl_;
 };

@@ -6,7 +6,9 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 #include "rp/control/DefaultPositionControl.hpp"
 #include "rp/io/IoBoard.hpp"
@@ -47,6 +49,21 @@ class SimulatedClock;
 /// The arm power is on when the loop starts, holding the position the arm is in. In simulation
 /// mode the arm starts at rest at the model's home position.
 ///
+/// Pose, mount and simulation mode: setTransform(), setConnection(), clearConnection(),
+/// setSimulationModeOn() and setSimulationModeOff() rebuild the model (its base is the mount
+/// frame's world pose, evaluated when called, times the object's pose) and switch between the
+/// simulated arm and the hardware, while the loop runs: the change takes effect at the next cycle
+/// boundary, before the call returns, and the arm holds where it is (a simulation taking over
+/// starts from the joint state the arm had; the hardware taking over holds where its encoders
+/// say). Allowed while nothing drives the arm: before a trajectory generator is set and while
+/// the DefaultPositionControl is in use (as the paper's Figure 23 does it: right after the
+/// declaration); otherwise, and during or after a shutdown, the call throws std::logic_error and
+/// changes nothing. Leaving the hardware switches its amplifiers off and writes 0 V first.
+/// Switching to the hardware without a configured hardware server throws std::runtime_error. A
+/// mount that moves later (an arm on another arm) is not followed: the base is where the mount
+/// was when the call was made. References from getModel() stay valid (models replaced are kept
+/// until the manipulator is destroyed) but describe the pose they were taken at.
+///
 /// Hardware (simulation mode off): the arm is reached through a hardware server named by rp.cfg's
 /// `hwserver NAME` (see rp-hwserver): joint j's angle is encoder j's count divided by
 /// `countsPerRadian` (default 20000), its velocity a filtered backward difference, its torque goes
@@ -75,9 +92,12 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   /// @param[out] schema  schema to add to
   static void declareSettings(SettingSchema& schema);
   /// Whether the arm is reached through a hardware server (simulation mode off).
-  bool usesHardware() const { return board_ != nullptr; }
+  /// Real-time safe: yes.
+  bool usesHardware() const { return usesHardware_.load(std::memory_order_acquire); }
 
-  const ManipulatorModel& getModel() const override { return *model_; }
+  /// The model for the current base pose (see the class comment on pose changes).
+  /// Real-time safe: yes.
+  const ManipulatorModel& getModel() const override { return *modelView_.load(std::memory_order_acquire); }
   double getServoPeriod() const override { return getPeriod(); }
   ControlProgram* getControlProgram() override { return this; }
 
@@ -154,6 +174,14 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void enterControl() override;
   void control() override;
   void exitControl() override;
+  /// Rebuilds the model and switches simulation and hardware after a change of pose, mount or
+  /// simulation mode (see the class comment).
+  /// @throws std::logic_error while a trajectory generator or another servo control drives the
+  ///         arm, or during or after a shutdown
+  /// @throws std::runtime_error switching to the hardware when none is configured, or if the
+  ///         servo loop does not take the change within 5 s
+  /// @throws IoException if the configured hardware server cannot be reached
+  void physicalSetupChanged() override;
 
  private:
   struct PublishedState {
@@ -164,6 +192,12 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
     double q[kMaxJoints] = {}, qd[kMaxJoints] = {}, tau[kMaxJoints] = {}, qdes[kMaxJoints] = {};
   };
   struct WrenchBox;
+  struct Setup;  // what is built from the pose and the simulation mode
+
+  std::unique_ptr<Setup> makeSetup(bool simulation, const Transform& base) const;
+  void install(Setup& setup) noexcept;     // swaps the setup's parts with the manipulator's
+  void applySetup(Setup& setup) noexcept;  // in the servo thread between cycles: install and carry the state over
+  void applyWrenches(int n);               // the last external wrenches to the simulation
 
   bool inServoThread() const;
   void waitUntilNotExecuting(const void* object) const;
@@ -184,7 +218,16 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void ioFailure(const char* what, int line);
   std::string noHardwareMessage() const;
 
-  std::unique_ptr<ManipulatorModel> model_;
+  ModelFactory modelFactory_;
+  std::unique_ptr<ManipulatorModel> model_;  // servo thread's; other threads use getModel()
+  std::atomic<const ManipulatorModel*> modelView_{nullptr};
+  std::vector<std::unique_ptr<ManipulatorModel>> retiredModels_;  // kept for references taken earlier
+  std::mutex setupMutex_;                                         // one pose or mode change at a time
+  std::atomic<Setup*> pendingSetup_{nullptr};                     // for the servo thread to take
+  std::atomic<Setup*> appliedSetup_{nullptr};                     // the servo thread took this one
+  bool builtForSimulation_ = true;                                // the mode and base the parts were built for
+  Transform builtBase_ = Transform::unit();
+  std::atomic<bool> usesHardware_{false};
   std::unique_ptr<ManipulatorData> data_;  // servo thread's
   std::unique_ptr<ManipulatorSimulation> sim_;
   std::unique_ptr<DefaultPositionControl> defaultControl_;

@@ -76,6 +76,13 @@ class Manipulator : public PhysicalObject {
   virtual Transform getEndEffectorTransform() const = 0;
   /// The same as getEndEffectorTransform() (the paper's Figure 22 spells it this way).
   Transform getEndEffectorPosition() const { return getEndEffectorTransform(); }
+  /// World pose of one of the arm's frames at the current joint positions [m]: `base` (the
+  /// model's base frame), `link1` to `linkN` (the frame of each link) or `endEffector`; other
+  /// objects are mounted on these (setConnection()).
+  /// @param[in] frame  frame name
+  /// @throws std::invalid_argument if the arm has no such frame
+  /// Real-time safe: no.
+  Transform getFrameTransform(const std::string& frame) const override;
   /// Joint torques that make the end-effector exert `force` (3: force [N]; 6: force and moment
   /// [N m]), in world coordinates, at the joint positions `q`: \f$\tau = J(q)^T F\f$.
   /// @param[in]  q       joint positions (n x 1) [rad]

@@ -3,6 +3,8 @@
 /// Homogeneous transformations and the transformation functions of Table 2: translation,
 /// rotations about x, y, z and an arbitrary axis, Euler (ZYZ) and roll-pitch-yaw angles.
 
+#include <string>
+
 #include "rp/math/Matrix.hpp"
 
 namespace rp {
@@ -64,5 +66,19 @@ Transform rigidInverse(const Transform& t);
 inline Vector<3> transformPoint(const Transform& t, const Vector<3>& p) {
   return Vector<3>(t.topLeftCorner<3, 3>() * p + t.topRightCorner<3, 1>());
 }
+
+/// Largest deviation accepted by rigidTransformError(): of \f$R^T R\f$ from the identity (each
+/// element), enough for a rotation typed with three or four decimals.
+constexpr double kRigidTransformTolerance = 1e-3;
+
+/// Checks that `pose` is a rigid transform: every element finite, the last row exactly
+/// `0 0 0 1`, and the rotation block a proper rotation (\f$R^T R = I\f$ within `tolerance` for
+/// each element, \f$\det R > 0\f$).
+/// @param[in] pose       the 4 x 4 matrix to check
+/// @param[in] tolerance  largest deviation of \f$R^T R\f$ from the identity accepted
+/// @return an empty string if it is one, else what is wrong (e.g. `its rotation block is not
+///         orthonormal (R^T R differs from I by 3)`), to follow a description of the pose
+/// Real-time safe: only when it returns an empty string.
+std::string rigidTransformError(const Transform& pose, double tolerance = kRigidTransformTolerance);
 
 }  // namespace rp

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 
+#include "rp/math/Transform.hpp"
 #include "rp/model/ManipulatorData.hpp"
 
 namespace rp {
@@ -33,20 +34,6 @@ struct IkOptions {
   /// (with `maxAttempts` = 1, the only one) always runs its `maxIterations`.
   int stallIterations = 12;
 };
-
-/// Largest deviation accepted by rigidTransformError(): of \f$R^T R\f$ from the identity (each
-/// element), enough for a rotation typed with three or four decimals.
-constexpr double kRigidTransformTolerance = 1e-3;
-
-/// Checks that `pose` is a rigid transform: every element finite, the last row exactly
-/// `0 0 0 1`, and the rotation block a proper rotation (\f$R^T R = I\f$ within `tolerance` for
-/// each element, \f$\det R > 0\f$).
-/// @param[in] pose       the 4 x 4 matrix to check
-/// @param[in] tolerance  largest deviation of \f$R^T R\f$ from the identity accepted
-/// @return an empty string if it is one, else what is wrong (e.g. `its rotation block is not
-///         orthonormal (R^T R differs from I by 3)`), to follow a description of the pose
-/// Real-time safe: only when it returns an empty string.
-std::string rigidTransformError(const Transform& pose, double tolerance = kRigidTransformTolerance);
 
 /// Solves \f$FK(q) = T\f$ by damped least squares (Levenberg-Marquardt) on the geometric
 /// Jacobian, keeping every joint inside its limits, starting from `seed` and then from random
