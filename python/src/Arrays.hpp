@@ -1,0 +1,35 @@
+// numpy <-> Eigen conversions of the Python module, checked: a wrong shape, a dtype that is not a
+// real number, or a value that is not finite is a ValueError naming the argument and the shape
+// expected, never a crash or a silent copy of the wrong size.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <string>
+
+#include "rp/math/Matrix.hpp"
+#include "rp/math/Transform.hpp"
+#include "rp/model/ManipulatorModel.hpp"
+
+namespace rp::python {
+
+namespace py = pybind11;
+
+/// A 1-D array of `n` finite real numbers (any real dtype) as a JointVector.
+/// @throws py::value_error naming `what` and the shape `(n,)` expected
+JointVector toVector(const py::handle& value, int n, const char* what);
+/// A 2-D array of shape (rows, cols) of finite reals, as a row-major double array (a copy).
+/// @param[in] rows  rows expected; -1: any number (the batch size)
+/// @throws py::value_error naming `what` and the shape expected
+py::array_t<double, py::array::c_style> toMatrix(const py::handle& value, int rows, int cols, const char* what);
+/// A 4 x 4 rigid transform.
+/// @throws py::value_error naming `what` if it is not 4 x 4, not finite or not rigid
+Transform toTransform(const py::handle& value, const char* what);
+
+/// A vector as a new 1-D float64 array.
+py::array_t<double> fromVector(const Eigen::Ref<const Eigen::VectorXd>& v);
+/// A matrix as a new 2-D float64 array.
+py::array_t<double> fromMatrix(const Eigen::Ref<const Eigen::MatrixXd>& m);
+
+}  // namespace rp::python

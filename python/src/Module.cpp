@@ -1,0 +1,20 @@
+// The Python module `roboticplatform` (import roboticplatform as rp): the library's exceptions
+// as Python exceptions, then the models and the platform.
+#include <pybind11/pybind11.h>
+
+#include "Bindings.hpp"
+#include "rp/core/Configuration.hpp"
+#include "rp/core/ObjectManager.hpp"
+#include "rp/io/IoException.hpp"
+#include "rp/math/MathException.hpp"
+
+PYBIND11_MODULE(_roboticplatform, m) {
+  namespace py = pybind11;
+  m.doc() = "Robotic Platform: models, trajectories and manipulators of the C++ library, with numpy arrays.";
+  py::register_exception<rp::ConfigError>(m, "ConfigError", PyExc_ValueError);
+  py::register_exception<rp::ObjectError>(m, "ObjectError", PyExc_RuntimeError);
+  py::register_exception<rp::MathException>(m, "MathError", PyExc_ValueError);
+  py::register_exception<rp::IoException>(m, "IoError", PyExc_OSError);
+  rp::python::bindModels(m);
+  rp::python::bindPlatform(m);
+}

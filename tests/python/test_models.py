@@ -1,0 +1,187 @@
+"""The models from Python: against Orocos KDL (python3-pykdl), finite differences, the batched
+forms, and bad input."""
+import threading
+
+import numpy as np
+import pytest
+
+import roboticplatform as rp
+import kdl_reference as kdl
+
+MODELS = [rp.Puma560Model, lambda: rp.WAMModel(7), lambda: rp.WAMModel(4)]
+
+
+def random_q(model, rng, count=None):
+    lo, hi = model.position_min, model.position_max
+    shape = (model.dof,) if count is None else (count, model.dof)
+    return rng.uniform(np.maximum(lo, -3), np.minimum(hi, 3), shape)
+
+
+@pytest.mark.parametrize("make", MODELS)
+def test_kinematics_and_inverse_dynamics_agree_with_kdl(make):
+    model = make()
+    reference = kdl.chain(model)
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        q = random_q(model, rng)
+        qd = rng.uniform(-1, 1, model.dof)
+        qdd = rng.uniform(-1, 1, model.dof)
+        np.testing.assert_allclose(model.fk(q), kdl.fk(reference, q), atol=1e-9)
+        np.testing.assert_allclose(model.jacobian(q), kdl.jacobian(reference, q), atol=1e-9)
+        np.testing.assert_allclose(model.rnea(q, qd, qdd), kdl.rnea(reference, model.gravity, q, qd, qdd), atol=1e-9)
+        np.testing.assert_allclose(model.gravity_torque(q), kdl.rnea(reference, model.gravity, q, 0 * q, 0 * q),
+                                   atol=1e-9)
+
+
+@pytest.mark.parametrize("make", MODELS)
+def test_jacobian_matches_finite_differences_of_fk(make):
+    model = make()
+    rng = np.random.default_rng(3)
+    q = random_q(model, rng)
+    h = 1e-6
+    J = model.jacobian(q)
+    T = model.fk(q)
+    for i in range(model.dof):
+        dq = np.zeros(model.dof)
+        dq[i] = h
+        Tp, Tm = model.fk(q + dq), model.fk(q - dq)
+        np.testing.assert_allclose(J[:3, i], (Tp[:3, 3] - Tm[:3, 3]) / (2 * h), atol=1e-7)
+        dR = (Tp[:3, :3] - Tm[:3, :3]) / (2 * h) @ T[:3, :3].T  # skew(omega)
+        np.testing.assert_allclose(J[3:, i], [dR[2, 1], dR[0, 2], dR[1, 0]], atol=1e-7)
+
+
+@pytest.mark.parametrize("make", MODELS)
+def test_mass_matrix_and_forward_dynamics_are_consistent_with_rnea(make):
+    model = make()
+    rng = np.random.default_rng(5)
+    q = random_q(model, rng)
+    qd = rng.uniform(-1, 1, model.dof)
+    tau = rng.uniform(-5, 5, model.dof)
+    M = model.crba(q)
+    # Column i of M is rnea with qdd = e_i minus the bias (gravity off, qd = 0).
+    for i in range(model.dof):
+        e = np.zeros(model.dof)
+        e[i] = 1
+        np.testing.assert_allclose(M[:, i], model.rnea(q, 0 * q, e, gravity=False), atol=1e-10)
+    qdd = model.aba(q, qd, tau)
+    np.testing.assert_allclose(model.rnea(q, qd, qdd), tau, atol=1e-9)
+
+
+@pytest.mark.parametrize("make", MODELS)
+def test_batched_calls_equal_single_calls(make):
+    model = make()
+    rng = np.random.default_rng(11)
+    Q, QD, QDD = random_q(model, rng, 50), rng.uniform(-1, 1, (50, model.dof)), rng.uniform(-1, 1, (50, model.dof))
+    fk, J, tau, M, acc = (model.fk_batch(Q), model.jacobian_batch(Q), model.rnea_batch(Q, QD, QDD), model.crba_batch(Q),
+                          model.aba_batch(Q, QD, QDD))
+    assert fk.shape == (50, 4, 4) and J.shape == (50, 6, model.dof) and M.shape == (50, model.dof, model.dof)
+    for k in range(50):
+        np.testing.assert_array_equal(fk[k], model.fk(Q[k]))
+        np.testing.assert_array_equal(J[k], model.jacobian(Q[k]))
+        np.testing.assert_array_equal(tau[k], model.rnea(Q[k], QD[k], QDD[k]))
+        np.testing.assert_array_equal(M[k], model.crba(Q[k]))
+        np.testing.assert_array_equal(acc[k], model.aba(Q[k], QD[k], QDD[k]))
+
+
+def test_batched_calls_in_threads_give_the_same_results():
+    model = rp.Puma560Model()
+    Q = random_q(model, np.random.default_rng(1), 20000)
+    expected = model.rnea_batch(Q, Q, Q)
+    results = [None, None]
+
+    def work(k):
+        results[k] = model.rnea_batch(Q, Q, Q)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        np.testing.assert_array_equal(r, expected)
+
+
+def test_puma_closed_form_ik_reproduces_random_poses_on_every_branch():
+    puma = rp.Puma560Model()
+    rng = np.random.default_rng(2)
+    for _ in range(20):
+        q = random_q(puma, rng)
+        pose = puma.fk(q)
+        solutions = puma.ik_all(pose)
+        assert len(solutions) == 8
+        assert len({s["branch"] for s in solutions}) == 8
+        for s in solutions:
+            np.testing.assert_allclose(puma.fk(s["q"]), pose, atol=1e-9)
+        status, closest = puma.ik_closest(pose, q)
+        if status == "solved":
+            np.testing.assert_allclose(puma.fk(closest), pose, atol=1e-9)
+    far = np.eye(4)
+    far[:3, 3] = [5, 0, 0]
+    assert puma.ik_all(far) == []
+
+
+def test_numeric_ik_solves_reachable_wam_poses():
+    wam = rp.WAMModel(7)
+    rng = np.random.default_rng(4)
+    for _ in range(5):
+        pose = wam.fk(random_q(wam, rng))
+        status, q = wam.ik(pose)
+        assert status == "solved"
+        np.testing.assert_allclose(wam.fk(q), pose, atol=1e-5)
+        assert wam.within_limits(q)
+
+
+def test_bad_input_is_a_clear_python_exception():
+    puma = rp.Puma560Model()
+    with pytest.raises(ValueError, match=r"q: expected shape \(6,\), got \(5,\)"):
+        puma.fk(np.zeros(5))
+    with pytest.raises(ValueError, match=r"q: expected shape \(6,\), got \(2, 3\)"):
+        puma.fk(np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="real numbers"):
+        puma.fk(np.array(["a"] * 6))
+    with pytest.raises(ValueError, match="real numbers"):
+        puma.fk(np.zeros(6, dtype=complex))
+    with pytest.raises(ValueError, match="element 2 is not a finite number"):
+        puma.rnea([0, 0, np.nan, 0, 0, 0], np.zeros(6), np.zeros(6))
+    with pytest.raises(ValueError, match="qd: expected shape"):
+        puma.rnea(np.zeros(6), np.zeros(7), np.zeros(6))
+    with pytest.raises(ValueError, match=r"q: expected shape \(N, 6\)"):
+        puma.fk_batch(np.zeros((10, 5)))
+    with pytest.raises(ValueError, match="same number of rows"):
+        puma.rnea_batch(np.zeros((10, 6)), np.zeros((9, 6)), np.zeros((10, 6)))
+    with pytest.raises(ValueError, match="not a rigid transform"):
+        puma.ik_all(2 * np.eye(4))
+    with pytest.raises(IndexError, match="link 6 is not in 0..5"):
+        puma.link(6)
+    with pytest.raises(ValueError, match="frame must be"):
+        puma.jacobian(puma.home, frame="elbow")
+    with pytest.raises(ValueError, match="dof must be 4 or 7"):
+        rp.WAMModel(5)
+    # Integers are real numbers: converted, not refused.
+    np.testing.assert_array_equal(puma.fk(np.zeros(6, dtype=int)), puma.fk(np.zeros(6)))
+
+
+def test_urdf_models_from_a_file_or_text_and_their_errors(tmp_path):
+    urdf = """<robot name="two">
+  <link name="base"/>
+  <link name="l1"><inertial><mass value="1"/><origin xyz="0.1 0 0"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="l2"><inertial><mass value="0.5"/><origin xyz="0.1 0 0"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="10" velocity="2"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.2 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="10" velocity="2"/></joint>
+</robot>"""
+    path = tmp_path / "two.urdf"
+    path.write_text(urdf)
+    from_file, from_text = rp.UrdfModel(str(path)), rp.UrdfModel(urdf)
+    assert from_file.dof == from_text.dof == 2
+    q = np.array([0.3, -0.4])
+    np.testing.assert_allclose(from_file.fk(q), from_text.fk(q), atol=1e-15)
+    # Planar two-link arm: the tip of link 2's frame is at 0.2 (cos q1) ...
+    np.testing.assert_allclose(from_file.link_transforms(q)[1][:2, 3], [0.2 * np.cos(0.3), 0.2 * np.sin(0.3)], atol=1e-12)
+    with pytest.raises(rp.UrdfError, match="missing.urdf"):
+        rp.UrdfModel(str(tmp_path / "missing.urdf"))
+    with pytest.raises(rp.UrdfError, match="<string>"):
+        rp.UrdfModel("<robot name='broken'><link name='a'/>")
