@@ -42,6 +42,21 @@ std::string exact(double x) {
   return buf;
 }
 
+std::string xmlEscape(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
 std::string brief(double x) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.6g", x);

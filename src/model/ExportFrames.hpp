@@ -37,6 +37,9 @@ PrincipalInertia principalInertia(const Matrix<3, 3>& inertia);
 
 // "%.17g": every double written round-trips exactly.
 std::string exact(double x);
+// Text as an XML attribute value: & < > " ' escaped (a URDF robot's name may hold any of them).
+std::string xmlEscape(const std::string& text);
+
 // "%.6g", for comments.
 std::string brief(double x);
 

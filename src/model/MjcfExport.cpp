@@ -56,7 +56,7 @@ std::string exportMjcf(const ManipulatorModel& model, const MjcfOptions& options
   const PhysicalModel physical = physicalModel(model);
   const ManipulatorModel& m = physical.model;
   std::ostringstream x;
-  x << "<mujoco model=\"" << model.getName() << "\">\n";
+  x << "<mujoco model=\"" << internal::xmlEscape(model.getName()) << "\">\n";
   x << "  <!-- Written by rp (exportMjcf). Joints carry the model's range, armature G^2 Jm, damping B G^2 and\n"
        "       friction loss |G| Tc (one value for both directions: the mean where the model's two differ, see\n"
        "       the comment at the joint). Velocity, acceleration and jerk limits are not carried.\n";

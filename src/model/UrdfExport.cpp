@@ -27,7 +27,7 @@ std::string toUrdf(const ManipulatorModel& model) {
   const ManipulatorModel& m = physical.model;
   std::ostringstream x;
   const int n = model.getNumberOfJoints();
-  x << "<?xml version=\"1.0\"?>\n<robot name=\"" << model.getName() << "\" xmlns:drake=\"http://drake.mit.edu\">\n";
+  x << "<?xml version=\"1.0\"?>\n<robot name=\"" << internal::xmlEscape(model.getName()) << "\" xmlns:drake=\"http://drake.mit.edu\">\n";
   x << "  <!-- Written by rp (toUrdf). URDF cannot carry everything the model has:\n"
        "       - motor inertia: each <transmission> gives the motor's inertia and gear ratio\n"
        "         (drake:rotor_inertia, drake:gear_ratio; Drake adds G^2 Jm to the joint), which plain URDF\n"

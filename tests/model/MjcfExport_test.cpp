@@ -209,6 +209,12 @@ TEST(MjcfExport, OptionsAndBadModels) {
   options = MjcfOptions();
   options.integrator = "leapfrog";
   EXPECT_THROW(exportMjcf(puma, options), std::invalid_argument);
+  // A name with XML's special characters (a URDF robot's name may have any) is escaped.
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < 6; ++i) links.push_back(puma.getLink(i));
+  const ManipulatorModel named("arm \"A\" & <B>", links);
+  MuJoCoModel escaped(exportMjcf(named), ".xml");
+  EXPECT_STREQ(escaped.m->names, "arm \"A\" & <B>");  // the model's name comes first
   // Kinematics only: no mass anywhere, nothing MuJoCo could simulate.
   LinkParameters massless;
   const ManipulatorModel kinematic("kinematic", {massless, massless});

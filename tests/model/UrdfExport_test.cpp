@@ -126,6 +126,15 @@ TEST(UrdfExport, MuJoCoLoadsTheExportsWithTheModelsDynamics) {
   compareUrdfWithMuJoCo(WAM4Model());
 }
 
+// A name with XML's special characters (a URDF robot's name may have any) is escaped.
+TEST(UrdfExport, NamesAreEscaped) {
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < 6; ++i) links.push_back(Puma560Model().getLink(i));
+  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(toUrdf(ManipulatorModel("arm \"A\" & <B>", links)));
+  ASSERT_TRUE(urdf);
+  EXPECT_EQ(urdf->getName(), "arm \"A\" & <B>");
+}
+
 // The motor inertia is in the file for the readers that know Drake's extension.
 TEST(UrdfExport, MotorInertiaAndGearRatioAreInTheTransmissions) {
   const Puma560Model puma;
