@@ -3,7 +3,7 @@
 //   rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] COMMAND --q v1,v2,... [options]
 //
 // COMMAND: fk | jacobian | gravity | rnea --qd .. --qdd .. | inertia | fd --qd .. --tau .. |
-//          ik --pose p1,...,p16 [--seed ..] | urdf
+//          ik --pose p1,...,p16 [--seed ..] | urdf | mjcf
 // Options: --motor-inertia and --friction add those effects to inertia, rnea and fd.
 // Units: SI and radians. Matrices are JSON arrays of rows. Bad input: one line on stderr, exit 2
 // (values that are not finite numbers, a --pose that is not a rigid transform).
@@ -90,7 +90,7 @@ int run(int argc, char** argv) {
     if (a == "--help" || a == "-h") {
       std::cout << "usage: rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] COMMAND --q v1,v2,... [--qd ..] [--qdd ..] [--tau ..]\n"
                    "                [--pose p1,...,p16] [--seed ..] [--motor-inertia] [--friction]\n"
-                   "COMMAND: fk jacobian gravity rnea inertia fd ik urdf\n";
+                   "COMMAND: fk jacobian gravity rnea inertia fd ik urdf mjcf\n";
       return 0;
     }
     if (a == "--motor-inertia" || a == "--friction") {
@@ -114,7 +114,8 @@ int run(int argc, char** argv) {
   else if (robot.size() > 5 && robot.substr(robot.size() - 5) == ".urdf") {
     UrdfOptions urdf;
     if (opts.count("--tip")) urdf.tip = opts.at("--tip");
-    urdf.requireDynamics = command == "gravity" || command == "rnea" || command == "inertia" || command == "fd";
+    urdf.requireDynamics =
+        command == "gravity" || command == "rnea" || command == "inertia" || command == "fd" || command == "mjcf";
     model = loadUrdf(robot, urdf);
   } else {
     throw UsageError("unknown robot '" + robot + "' (known: puma560, wam4, wam7, or a .urdf file)");
@@ -134,6 +135,9 @@ int run(int argc, char** argv) {
   json out;
   if (command == "urdf") {
     std::cout << toUrdf(*model);
+    return 0;
+  } else if (command == "mjcf") {
+    std::cout << exportMjcf(*model);
     return 0;
   } else if (command == "ik") {
     const auto poseIt = opts.find("--pose");
@@ -178,8 +182,8 @@ int run(int argc, char** argv) {
       out["qdd"] = vector(forwardDynamics(*model, data, q, jointsOf(opts, "--qd", n, true),
                                           jointsOf(opts, "--tau", n, true), dyn));
     } else {
-      throw UsageError(command.empty() ? "missing COMMAND (fk jacobian gravity rnea inertia fd ik urdf)"
-                                       : "unknown command '" + command + "' (fk jacobian gravity rnea inertia fd ik urdf)");
+      throw UsageError(command.empty() ? "missing COMMAND (fk jacobian gravity rnea inertia fd ik urdf mjcf)"
+                                       : "unknown command '" + command + "' (fk jacobian gravity rnea inertia fd ik urdf mjcf)");
     }
   }
   std::cout << out.dump() << std::endl;

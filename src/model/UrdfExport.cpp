@@ -5,50 +5,84 @@
 #include <cstdio>
 #include <sstream>
 
+#include "ExportFrames.hpp"
+#include "rp/model/PhysicalModel.hpp"
+
 namespace rp {
 
 namespace {
 
+using internal::exact;
+
 std::string origin(const Transform& t) {
   const Vector<3> rpy = transformToRPY(t);
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "<origin xyz=\"%.17g %.17g %.17g\" rpy=\"%.17g %.17g %.17g\"/>", t(0, 3), t(1, 3),
-                t(2, 3), rpy(0), rpy(1), rpy(2));
-  return buf;
+  return "<origin xyz=\"" + exact(t(0, 3)) + " " + exact(t(1, 3)) + " " + exact(t(2, 3)) + "\" rpy=\"" + exact(rpy(0)) +
+         " " + exact(rpy(1)) + " " + exact(rpy(2)) + "\"/>";
 }
 
 }  // namespace
 
 std::string toUrdf(const ManipulatorModel& model) {
+  const PhysicalModel physical = physicalModel(model);
+  const ManipulatorModel& m = physical.model;
   std::ostringstream x;
-  x.precision(17);
   const int n = model.getNumberOfJoints();
-  x << "<?xml version=\"1.0\"?>\n<robot name=\"" << model.getName() << "\">\n";
+  x << "<?xml version=\"1.0\"?>\n<robot name=\"" << internal::xmlEscape(model.getName()) << "\" xmlns:drake=\"http://drake.mit.edu\">\n";
+  x << "  <!-- Written by rp (toUrdf). URDF cannot carry everything the model has:\n"
+       "       - motor inertia: each <transmission> gives the motor's inertia and gear ratio\n"
+       "         (drake:rotor_inertia, drake:gear_ratio; Drake adds G^2 Jm to the joint), which plain URDF\n"
+       "         readers (urdfdom, MuJoCo, rp's loadUrdf) ignore; the MJCF export carries it as armature;\n"
+       "       - two-sided Coulomb friction: <dynamics friction> has one value, the mean of the two\n"
+       "         magnitudes (a comment at each such joint gives both);\n"
+       "       - acceleration and jerk limits.\n";
+  if (!physical.corrections.empty()) {
+    x << "       Inertial data changed so that simulators accept them (rp's physicalModel):\n"
+      << internal::correctionLines(physical, "       ");
+  }
+  x << "  -->\n";
   x << "  <link name=\"world\"/>\n  <link name=\"base_link\"/>\n";
   x << "  <joint name=\"base\" type=\"fixed\">\n    <parent link=\"world\"/>\n    <child link=\"base_link\"/>\n    "
     << origin(model.getBaseTransform()) << "\n  </joint>\n";
-  // A_k = Pre_k Joint(q_k) Post_k: the URDF link k frame is the joint frame after the motion,
-  // joint k sits at Post_{k-1} Pre_k in link k-1, link k's inertia at Post_k com.
-  Transform previous = Transform::unit();  // Post_{k-1}
-  const bool standard = model.getConvention() == DHConvention::Standard;
+  Transform previous = Transform::unit();  // post_{k-1}
   for (int k = 0; k < n; ++k) {
-    const LinkParameters& l = model.getLink(k);
-    const Transform fixed = zRotation(l.offset) * translation(0, 0, l.d);
-    const Transform pre = standard ? fixed : Transform(xRotation(l.alpha) * translation(l.a, 0, 0) * fixed);
-    const Transform post = standard ? Transform(translation(l.a, 0, 0) * xRotation(l.alpha)) : Transform::unit();
+    const LinkParameters& l = m.getLink(k);
+    const internal::JointFrames frames = internal::jointFrames(m, k);
+    const internal::JointFriction friction = internal::jointFriction(l);
     const std::string link = "link" + std::to_string(k + 1);
-    x << "  <link name=\"" << link << "\">\n    <inertial>\n      " << origin(Transform(post * translation(l.com)))
-      << "\n      <mass value=\"" << l.mass << "\"/>\n      <inertia ixx=\"" << l.inertia(0, 0) << "\" ixy=\""
-      << l.inertia(0, 1) << "\" ixz=\"" << l.inertia(0, 2) << "\" iyy=\"" << l.inertia(1, 1) << "\" iyz=\""
-      << l.inertia(1, 2) << "\" izz=\"" << l.inertia(2, 2) << "\"/>\n    </inertial>\n  </link>\n";
-    x << "  <joint name=\"joint" << k + 1 << "\" type=\"" << (l.type == JointType::Prismatic ? "prismatic" : "revolute")
+    const std::string joint = "joint" + std::to_string(k + 1);
+    const internal::PrincipalInertia principal = internal::principalInertia(l.inertia);
+    Transform axes = Transform::unit();
+    axes.topLeftCorner<3, 3>() = principal.axes;
+    x << "  <link name=\"" << link << "\">\n    <inertial>\n      "
+      << origin(Transform(frames.post * translation(l.com) * axes)) << "\n      <mass value=\"" << exact(l.mass)
+      << "\"/>\n      <inertia ixx=\"" << exact(principal.moments(0)) << "\" ixy=\"0\" ixz=\"0\" iyy=\""
+      << exact(principal.moments(1)) << "\" iyz=\"0\" izz=\"" << exact(principal.moments(2))
+      << "\"/>\n    </inertial>\n  </link>\n";
+    x << "  <joint name=\"" << joint << "\" type=\"" << (l.type == JointType::Prismatic ? "prismatic" : "revolute")
       << "\">\n    <parent link=\"" << (k == 0 ? std::string("base_link") : "link" + std::to_string(k))
-      << "\"/>\n    <child link=\"" << link << "\"/>\n    " << origin(Transform(previous * pre))
-      << "\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" << l.positionMin << "\" upper=\"" << l.positionMax
-      << "\" effort=\"" << l.torqueLimit << "\" velocity=\"" << l.velocityLimit << "\"/>\n    <dynamics damping=\""
-      << l.viscousFriction * l.gearRatio * l.gearRatio << "\" friction=\""
-      << std::abs(l.gearRatio) * 0.5 * (l.coulombFrictionPositive - l.coulombFrictionNegative) << "\"/>\n  </joint>\n";
-    previous = post;
+      << "\"/>\n    <child link=\"" << link << "\"/>\n    " << origin(Transform(previous * frames.pre))
+      << "\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" << exact(l.positionMin) << "\" upper=\""
+      << exact(l.positionMax) << "\" effort=\"" << exact(l.torqueLimit) << "\" velocity=\"" << exact(l.velocityLimit)
+      << "\"/>\n    <dynamics damping=\"" << exact(l.viscousFriction * l.gearRatio * l.gearRatio) << "\" friction=\""
+      << exact(friction.symmetric) << "\"/>\n";
+    if (friction.positive != friction.negative) {
+      x << "    <!-- Coulomb friction " << internal::brief(friction.positive) << " for positive and "
+        << internal::brief(friction.negative) << " for negative motion; URDF has one value: their mean -->\n";
+    }
+    x << "  </joint>\n";
+    if (l.motorInertia != 0 || l.gearRatio != 1) {
+      x << "  <transmission name=\"" << joint << "_transmission\">\n"
+        << "    <type>transmission_interface/SimpleTransmission</type>\n"
+        << "    <joint name=\"" << joint << "\">\n"
+        << "      <hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>\n    </joint>\n"
+        << "    <actuator name=\"" << joint << "_motor\">\n"
+        << "      <mechanicalReduction>" << exact(l.gearRatio) << "</mechanicalReduction>\n"
+        << "      <drake:rotor_inertia value=\"" << exact(l.motorInertia) << "\"/>\n"
+        << "      <drake:gear_ratio value=\"" << exact(std::abs(l.gearRatio)) << "\"/>\n"
+        << "    </actuator>\n    <!-- armature G^2 Jm = " << internal::brief(m.getArmatureInertia()(k)) << " at the joint -->\n"
+        << "  </transmission>\n";
+    }
+    previous = frames.post;
   }
   x << "  <link name=\"tool\"/>\n  <joint name=\"tool\" type=\"fixed\">\n    <parent link=\"link" << n
     << "\"/>\n    <child link=\"tool\"/>\n    " << origin(Transform(previous * model.getToolTransform()))

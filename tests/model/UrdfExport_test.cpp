@@ -1,13 +1,21 @@
-// The URDF export read back with urdfdom: walking its joints gives the model's forward kinematics.
+// The URDF export read back with urdfdom (walking its joints gives the model's forward
+// kinematics), loaded by MuJoCo (Debian's libmujoco-dev, linked into this test only: its mass
+// matrix and bias forces equal the model's), and reloaded with rp's own loader (the same arm but
+// for what URDF cannot carry).
 #include <gtest/gtest.h>
 
 #include <urdf_parser/urdf_parser.h>
 
+#include <fstream>
 #include <random>
 
+#include "MuJoCo.hpp"
+#include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
+#include "rp/model/PhysicalModel.hpp"
 #include "rp/model/Puma560Model.hpp"
 #include "rp/model/UrdfExport.hpp"
+#include "rp/model/UrdfModel.hpp"
 #include "rp/model/WAMModel.hpp"
 
 namespace rp {
@@ -48,12 +56,14 @@ void checkRobot(const ManipulatorModel& model) {
     T = Transform(T * pose(urdf->getJoint("tool")->parent_to_joint_origin_transform));
     EXPECT_LT((T - forwardKinematics(model, data, q)).cwiseAbs().maxCoeff(), 1e-12) << model.getName();
   }
-  double mass = 0, urdfMass = 0;
+  // The masses written are physicalModel()'s: the model's, but for a link with none (the Puma's
+  // link 1), which gets kExportMassFloor of the arm's.
+  double mass = 0;
+  for (int k = 0; k < n; ++k) mass += model.getLink(k).mass;
   for (int k = 0; k < n; ++k) {
-    mass += model.getLink(k).mass;
-    urdfMass += urdf->getLink("link" + std::to_string(k + 1))->inertial->mass;
+    const double written = urdf->getLink("link" + std::to_string(k + 1))->inertial->mass;
+    EXPECT_EQ(written, model.getLink(k).mass > 0 ? model.getLink(k).mass : kExportMassFloor * mass);
   }
-  EXPECT_DOUBLE_EQ(urdfMass, mass);
 }
 
 TEST(UrdfExport, ForwardKinematicsOfTheExportedRobotsMatch) {
@@ -61,6 +71,156 @@ TEST(UrdfExport, ForwardKinematicsOfTheExportedRobotsMatch) {
   checkRobot(Puma560Model(0.67183, translation(1, 2, 0) * zRotation(0.5), translation(0, 0, 0.1)));
   checkRobot(WAM7Model());
   checkRobot(WAM4Model());
+}
+
+// MuJoCo loads the URDF export (it refused the Puma's: link 1 was massless with an inertia, link 3's
+// inertia broke the triangle inequality), reads its damping and friction, and finds the mass
+// matrix, bias forces and gravity of physicalModel() without motor inertia (which URDF has no
+// field for; MuJoCo ignores the <transmission>).
+void compareUrdfWithMuJoCo(const ManipulatorModel& model) {
+  SCOPED_TRACE(model.getName());
+  const std::string text = toUrdf(model);
+  std::unique_ptr<test::MuJoCoModel> mj;
+  ASSERT_NO_THROW(mj = std::make_unique<test::MuJoCoModel>(text, ".urdf")) << text;
+  const PhysicalModel exported = physicalModel(model);
+  const ManipulatorModel& physical = exported.model;
+  const int n = model.getNumberOfJoints();
+  ASSERT_EQ(mj->m->nv, n);
+  for (int i = 0; i < n; ++i) {
+    const LinkParameters& l = model.getLink(i);
+    EXPECT_DOUBLE_EQ(mj->m->dof_damping[i], l.viscousFriction * l.gearRatio * l.gearRatio);
+    EXPECT_DOUBLE_EQ(mj->m->dof_frictionloss[i],
+                     0.5 * std::abs(l.gearRatio) * (l.coulombFrictionPositive - l.coulombFrictionNegative));
+    EXPECT_EQ(mj->m->dof_armature[i], 0) << "URDF carries no armature MuJoCo reads";
+  }
+  ManipulatorData data(physical);
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(0, 1);
+  double worstM = 0, worstBias = 0, worstGravity = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    JointVector q(n), qd(n), zero(n);
+    zero.setZero();
+    for (int i = 0; i < n; ++i) {
+      q(i) = model.getPositionMin()(i) + u(rng) * (model.getPositionMax()(i) - model.getPositionMin()(i));
+      qd(i) = (2 * u(rng) - 1) * model.getVelocityLimit()(i);
+    }
+    mj->forward(q, qd);
+    worstM = std::max(worstM, test::relativeError(mj->massMatrix(), massMatrix(physical, data, q)));
+    worstBias = std::max(worstBias, test::relativeError(mj->bias(), inverseDynamics(physical, data, q, qd, zero)));
+    mj->forward(q, zero);
+    JointVector g(n);
+    gravityTorque(physical, data, q, g);
+    worstGravity = std::max(worstGravity, test::relativeError(mj->bias(), g));
+  }
+  std::printf("%s URDF in MuJoCo against rp: mass matrix %.2e, bias forces %.2e, gravity %.2e relative\n",
+              model.getName().c_str(), worstM, worstBias, worstGravity);
+  EXPECT_LT(worstM, 1e-9);
+  EXPECT_LT(worstBias, 1e-9);
+  EXPECT_LT(worstGravity, 1e-9);
+}
+
+TEST(UrdfExport, MuJoCoLoadsTheExportsWithTheModelsDynamics) {
+  compareUrdfWithMuJoCo(Puma560Model());
+  compareUrdfWithMuJoCo(Puma560Model(0.67183, translation(1, 2, 0) * zRotation(0.5), translation(0, 0, 0.1)));
+  compareUrdfWithMuJoCo(WAM7Model());
+  compareUrdfWithMuJoCo(WAM4Model());
+}
+
+// A name with XML's special characters (a URDF robot's name may have any) is escaped.
+TEST(UrdfExport, NamesAreEscaped) {
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < 6; ++i) links.push_back(Puma560Model().getLink(i));
+  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(toUrdf(ManipulatorModel("arm \"A\" & <B>", links)));
+  ASSERT_TRUE(urdf);
+  EXPECT_EQ(urdf->getName(), "arm \"A\" & <B>");
+}
+
+// The motor inertia is in the file for the readers that know Drake's extension.
+TEST(UrdfExport, MotorInertiaAndGearRatioAreInTheTransmissions) {
+  const Puma560Model puma;
+  const std::string text = toUrdf(puma);
+  for (int k = 0; k < 6; ++k) {
+    const LinkParameters& l = puma.getLink(k);
+    const std::string joint = "joint" + std::to_string(k + 1);
+    const std::size_t at = text.find("<transmission name=\"" + joint + "_transmission\">");
+    ASSERT_NE(at, std::string::npos) << joint;
+    const std::string transmission = text.substr(at, text.find("</transmission>", at) - at);
+    EXPECT_NE(transmission.find("<joint name=\"" + joint + "\">"), std::string::npos);
+    char rotor[80], ratio[80];
+    std::snprintf(rotor, sizeof rotor, "<drake:rotor_inertia value=\"%.17g\"/>", l.motorInertia);
+    std::snprintf(ratio, sizeof ratio, "<drake:gear_ratio value=\"%.17g\"/>", std::abs(l.gearRatio));
+    EXPECT_NE(transmission.find(rotor), std::string::npos) << transmission;
+    EXPECT_NE(transmission.find(ratio), std::string::npos) << transmission;
+  }
+  UrdfOptions options;
+  options.tip = "tool";
+  EXPECT_EQ(toUrdf(*loadUrdf(std::string(RP_TEST_DATA_DIR) + "/test_arm.urdf", options)).find("<transmission name"),
+            std::string::npos)
+      << "no motor inertia, gear ratio 1: no transmission";
+}
+
+// A Puma reloaded from its own URDF with rp's loader is the exported arm (physicalModel()) as far
+// as URDF goes: the same kinematics, mass matrix without motor inertia, gravity (that of the
+// published Puma too), viscous friction, and the mean Coulomb friction. What differs from the
+// published Puma, measured: the motor inertia (URDF has no field for it; the loader does not read
+// Drake's <transmission> extension), link 3's inertia, and the two-sided friction.
+TEST(UrdfExport, PumaReloadedFromItsExportIsTheSameArmAsFarAsUrdfGoes) {
+  const Puma560Model puma;
+  const PhysicalModel exported = physicalModel(puma);
+  const ManipulatorModel& physical = exported.model;
+  const std::string file = testing::TempDir() + "/puma560_export_reload.urdf";
+  std::ofstream(file) << toUrdf(puma);
+  UrdfOptions options;
+  options.tip = "tool";
+  options.requireDynamics = true;
+  const std::unique_ptr<ManipulatorModel> back = loadUrdf(file, options);
+  ASSERT_EQ(back->getNumberOfJoints(), 6);
+  for (int i = 0; i < 6; ++i) {
+    const LinkParameters& l = puma.getLink(i);
+    const LinkParameters& r = back->getLink(i);
+    EXPECT_EQ(back->getArmatureInertia()(i), 0) << "lost: URDF has no motor inertia";
+    EXPECT_DOUBLE_EQ(r.viscousFriction * r.gearRatio * r.gearRatio, l.viscousFriction * l.gearRatio * l.gearRatio);
+    const double mean = 0.5 * std::abs(l.gearRatio) * (l.coulombFrictionPositive - l.coulombFrictionNegative);
+    EXPECT_DOUBLE_EQ(std::abs(r.gearRatio) * r.coulombFrictionPositive, mean);
+    EXPECT_DOUBLE_EQ(-std::abs(r.gearRatio) * r.coulombFrictionNegative, mean);
+    EXPECT_EQ(back->getPositionMin()(i), puma.getPositionMin()(i));
+    EXPECT_EQ(back->getPositionMax()(i), puma.getPositionMax()(i));
+    EXPECT_EQ(back->getTorqueLimit()(i), puma.getTorqueLimit()(i));
+  }
+  ManipulatorData a(puma), b(*back), c(physical);
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(0, 1);
+  double worstPose = 0, worstM = 0, worstGravity = 0, worstBias = 0, armatureShare = 0, link3 = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    JointVector q(6), qd(6), zero(6);
+    zero.setZero();
+    for (int i = 0; i < 6; ++i) {
+      q(i) = puma.getPositionMin()(i) + u(rng) * (puma.getPositionMax()(i) - puma.getPositionMin()(i));
+      qd(i) = (2 * u(rng) - 1) * puma.getVelocityLimit()(i);
+    }
+    worstPose = std::max(worstPose, (forwardKinematics(*back, b, q) - forwardKinematics(puma, a, q)).cwiseAbs().maxCoeff());
+    const JointMatrix M = massMatrix(*back, b, q);
+    worstM = std::max(worstM, test::relativeError(M, massMatrix(physical, c, q)));
+    worstBias = std::max(worstBias, test::relativeError(inverseDynamics(*back, b, q, qd, zero),
+                                                        inverseDynamics(physical, c, q, qd, zero)));
+    JointVector g1(6), g2(6);
+    gravityTorque(*back, b, q, g1);
+    gravityTorque(puma, a, q, g2);
+    worstGravity = std::max(worstGravity, test::relativeError(g1, g2));
+    // What the published Puma has on top: the armature on the diagonal, link 3's published inertia.
+    const JointMatrix published = massMatrix(puma, a, q, true);
+    armatureShare = std::max(armatureShare, puma.getArmatureInertia()(1) / published(1, 1));  // the shoulder
+    link3 = std::max(link3, (M - massMatrix(puma, a, q)).cwiseAbs().maxCoeff());
+  }
+  std::printf("Puma reloaded from its URDF: pose %.2e, mass matrix %.2e, C qd + g %.2e against the export; gravity "
+              "%.2e against the published Puma; lost armature up to %.0f%% of the shoulder's inertia; link 3 changes M by "
+              "%.5f kg m^2\n",
+              worstPose, worstM, worstBias, worstGravity, 100 * armatureShare, link3);
+  EXPECT_LT(worstPose, 1e-12);
+  EXPECT_LT(worstM, 1e-9);
+  EXPECT_LT(worstBias, 1e-9);
+  EXPECT_LT(worstGravity, 1e-9);
+  EXPECT_GT(armatureShare, 0.4);  // the 45% of the shoulder's inertia
 }
 
 }  // namespace

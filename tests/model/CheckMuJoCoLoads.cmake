@@ -1,0 +1,21 @@
+# Runs `rp-model ARGS...` as a user does to export a model, and checks that it exits with status 0
+# and that MuJoCo loads what it wrote and simulates it (tests/model/mujoco_load.cpp):
+#   PROGRAM  rp-model;  ARGS  its arguments (a CMake list)
+#   LOADER   mujoco_load;  OUT  the file to write (its extension, .xml or .urdf, picks MuJoCo's parser)
+#   NQ       the number of joints MuJoCo must find
+file(REMOVE ${OUT})
+execute_process(COMMAND ${PROGRAM} ${ARGS} OUTPUT_FILE ${OUT} ERROR_VARIABLE err RESULT_VARIABLE rc TIMEOUT 120)
+if(NOT "${rc}" STREQUAL "0")
+  message(FATAL_ERROR "rp-model ${ARGS}: exit status ${rc}, expected 0: ${err}")
+endif()
+if(NOT "${err}" STREQUAL "")
+  message(FATAL_ERROR "rp-model ${ARGS} wrote on stderr: ${err}")
+endif()
+execute_process(COMMAND ${LOADER} ${OUT} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 120)
+message("${out}${err}")
+if(NOT "${rc}" STREQUAL "0")
+  message(FATAL_ERROR "MuJoCo does not load or simulate the output of rp-model ${ARGS} (status ${rc})")
+endif()
+if(NOT out MATCHES "MuJoCo loads [^\n]*: nq=${NQ} ")
+  message(FATAL_ERROR "MuJoCo did not find ${NQ} joints")
+endif()
