@@ -14,7 +14,11 @@ pybind11::object makeModelCopy(const ManipulatorModel& model);
 
 /// Models and their algorithms (Models.cpp).
 void bindModels(pybind11::module_& m);
-/// The platform, manipulators and trajectories (Platform.cpp).
+/// The platform and manipulators (Platform.cpp).
 void bindPlatform(pybind11::module_& m);
+/// Joint motions planned and sampled without an arm (Trajectories.cpp).
+void bindTrajectories(pybind11::module_& m);
+/// The model of a Python Model object (Models.cpp); a TypeError for anything else.
+const ManipulatorModel& modelOf(const pybind11::handle& object);
 
 }  // namespace rp::python

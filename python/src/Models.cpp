@@ -129,6 +129,8 @@ JointVector row(const py::array_t<double, py::array::c_style>& a, py::ssize_t r,
 
 }  // namespace
 
+const ManipulatorModel& modelOf(const py::handle& object) { return *object.cast<const PyModel&>().model; }
+
 py::object makeModelCopy(const ManipulatorModel& model) {
   return py::cast(std::make_unique<PyModel>(std::make_shared<ManipulatorModel>(model)));
 }

@@ -17,4 +17,5 @@ PYBIND11_MODULE(_roboticplatform, m) {
   py::register_exception<rp::IoException>(m, "IoError", PyExc_OSError);
   rp::python::bindModels(m);
   rp::python::bindPlatform(m);
+  rp::python::bindTrajectories(m);
 }

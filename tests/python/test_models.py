@@ -185,3 +185,30 @@ def test_urdf_models_from_a_file_or_text_and_their_errors(tmp_path):
         rp.UrdfModel(str(tmp_path / "missing.urdf"))
     with pytest.raises(rp.UrdfError, match="<string>"):
         rp.UrdfModel("<robot name='broken'><link name='a'/>")
+
+
+def test_a_planned_joint_motion_is_time_optimal_within_the_limits_and_consistent():
+    puma = rp.Puma560Model()
+    start = puma.home
+    target = start.copy()
+    target[0] += 1.5  # joint 1 alone: the classic seven-phase S-curve
+    plan = rp.plan_joint_motion(puma, np.vstack([start, target]), rate=1000)
+    v, a, j = puma.velocity_limit[0], puma.acceleration_limit[0], puma.jerk_limit[0]
+    # Published closed form (cruise reached): T = d / v + v / a + a / j.
+    assert 1.5 / v > v / a + a / j, "the test distance reaches the cruise speed"
+    assert plan["duration"] == pytest.approx(1.5 / v + v / a + a / j, rel=1e-9)
+    t, q, qd, qdd = plan["time"], plan["q"], plan["qd"], plan["qdd"]
+    np.testing.assert_allclose(q[0], start, atol=1e-12)
+    np.testing.assert_allclose(q[-1], target, atol=1e-3 * 1.5)
+    assert np.all(np.abs(qd[:, 0]) <= v * (1 + 1e-9)) and np.all(np.abs(qdd[:, 0]) <= a * (1 + 1e-9))
+    # The velocity is the derivative of the position (central differences).
+    np.testing.assert_allclose(np.gradient(q[:, 0], t)[1:-1], qd[1:-1, 0], atol=2e-3)
+    # Through a via point, at rest there; half the speed fraction takes twice the time.
+    via = start + 0.3
+    slow = rp.plan_joint_motion(puma, np.vstack([start, via, target]), rate=500, speed_fraction=0.5)
+    fast = rp.plan_joint_motion(puma, np.vstack([start, via, target]), rate=500)
+    assert slow["duration"] == pytest.approx(2 * fast["duration"], rel=1e-9)
+    with pytest.raises(ValueError, match="at least two rows"):
+        rp.plan_joint_motion(puma, start[None, :])
+    with pytest.raises(ValueError, match="speed_fraction"):
+        rp.plan_joint_motion(puma, np.vstack([start, target]), speed_fraction=2)

@@ -1,0 +1,75 @@
+// Trajectories planned and sampled in Python without an arm: the library's jerk-limited joint
+// motion (JointLineSegment, the same profile as TrajectoryGenerator.move) through waypoints.
+#include <pybind11/pybind11.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "Arrays.hpp"
+#include "Bindings.hpp"
+#include "rp/trajectory/JointLineSegment.hpp"
+
+namespace rp::python {
+
+void bindTrajectories(py::module_& m) {
+  m.def(
+      "plan_joint_motion",
+      [](const py::handle& modelObject, const py::handle& waypoints, double rate, double speedFraction) {
+        const ManipulatorModel& model = modelOf(modelObject);
+        const int n = model.getNumberOfJoints();
+        if (!(rate > 0) || !std::isfinite(rate)) throw py::value_error("rate must be a positive number of samples per second");
+        if (!(speedFraction > 0 && speedFraction <= 1)) throw py::value_error("speed_fraction must be in (0, 1]");
+        auto points = toMatrix(waypoints, -1, n, "waypoints");
+        const py::ssize_t count = points.shape(0);
+        if (count < 2) throw py::value_error("waypoints: at least two rows (the start and a target)");
+        auto rowOf = [&](py::ssize_t r) {
+          JointVector v(n);
+          for (int i = 0; i < n; ++i) v(i) = points.data()[r * n + i];
+          return v;
+        };
+        // Time scaling by f: velocity f, acceleration f^2, jerk f^3 of the limits.
+        const JointVector vmax = model.getVelocityLimit() * speedFraction;
+        const JointVector amax = model.getAccelerationLimit() * (speedFraction * speedFraction);
+        const JointVector jmax = model.getJerkLimit() * (speedFraction * speedFraction * speedFraction);
+        std::vector<JointLineSegment> segments;
+        std::vector<double> starts{0.0};
+        for (py::ssize_t r = 0; r + 1 < count; ++r) {
+          segments.emplace_back(rowOf(r), rowOf(r + 1), vmax, amax, jmax);
+          starts.push_back(starts.back() + segments.back().getDuration());
+        }
+        const double duration = starts.back();
+        const auto samples = static_cast<py::ssize_t>(std::floor(duration * rate + 1e-9)) + 1;
+        py::array_t<double> t(samples), q({samples, py::ssize_t{n}}), qd({samples, py::ssize_t{n}}),
+            qdd({samples, py::ssize_t{n}});
+        Setpoint sp;
+        sp.position.resize(n);
+        sp.velocity.resize(n);
+        sp.acceleration.resize(n);
+        std::size_t segment = 0;
+        for (py::ssize_t k = 0; k < samples; ++k) {
+          const double time = static_cast<double>(k) / rate;
+          while (segment + 1 < segments.size() && time > starts[segment + 1]) ++segment;
+          segments[segment].evaluate(time - starts[segment], sp);
+          t.mutable_data()[k] = time;
+          for (int i = 0; i < n; ++i) {
+            q.mutable_data()[k * n + i] = sp.position(i);
+            qd.mutable_data()[k * n + i] = sp.velocity(i);
+            qdd.mutable_data()[k * n + i] = sp.acceleration(i);
+          }
+        }
+        py::dict out;
+        out["time"] = t;
+        out["q"] = q;
+        out["qd"] = qd;
+        out["qdd"] = qdd;
+        out["duration"] = duration;
+        return out;
+      },
+      py::arg("model"), py::arg("waypoints"), py::arg("rate") = 1000.0, py::arg("speed_fraction") = 1.0,
+      "Plans rest-to-rest jerk-limited joint motions through the rows of `waypoints` (K x dof, the first row the "
+      "start) within the model's velocity, acceleration and jerk limits (scaled in time by speed_fraction), and "
+      "samples them at `rate` Hz: a dict of time (N), q, qd, qdd (N x dof) and duration [s].");
+}
+
+}  // namespace rp::python
