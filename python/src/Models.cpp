@@ -9,6 +9,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 #include <unistd.h>
 
 #include "Arrays.hpp"
@@ -314,6 +315,73 @@ void bindModels(py::module_& m) {
           },
           py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("gravity") = true, py::arg("motor_inertia") = false,
           py::arg("friction") = false, "rnea of every row: N x dof")
+      .def(
+          "gravity_torque_batch",
+          [](const PyModel& p, const py::handle& qs) {
+            const int n = p.dof();
+            auto q = toMatrix(qs, -1, n, "q");
+            const py::ssize_t rows = q.shape(0);
+            py::array_t<double> out({rows, py::ssize_t{n}});
+            double* o = out.mutable_data();
+            {
+              py::gil_scoped_release release;
+              ManipulatorData data(*p.model);
+              JointVector tau(n);
+              for (py::ssize_t r = 0; r < rows; ++r) {
+                gravityTorque(*p.model, data, row(q, r, n), tau);
+                for (int i = 0; i < n; ++i) o[r * n + i] = tau(i);
+              }
+            }
+            return out;
+          },
+          py::arg("q"), "gravity_torque of every row: N x dof")
+      .def(
+          "ik_batch",
+          [](const PyModel& p, const py::handle& poses, const py::object& seeds, double positionTolerance,
+             double orientationTolerance, int maxAttempts) {
+            const int n = p.dof();
+            py::array_t<double, py::array::c_style | py::array::forcecast> a =
+                py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(poses);
+            if (!a || a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
+              throw py::value_error("poses: expected an array of shape (N, 4, 4)");
+            const py::ssize_t rows = a.shape(0);
+            std::vector<Transform> targets(static_cast<std::size_t>(rows));
+            for (py::ssize_t r = 0; r < rows; ++r) {
+              Transform t;
+              for (int i = 0; i < 4; ++i)
+                for (int j = 0; j < 4; ++j) t(i, j) = a.data()[(r * 4 + i) * 4 + j];
+              if (const std::string problem = rigidTransformError(t); !problem.empty())
+                throw py::value_error("poses[" + std::to_string(r) + "]: not a rigid transform: it " + problem);
+              targets[static_cast<std::size_t>(r)] = t;
+            }
+            py::array_t<double, py::array::c_style> seed;
+            if (!seeds.is_none()) {
+              seed = toMatrix(seeds, -1, n, "seeds");
+              if (seed.shape(0) != rows) throw py::value_error("seeds: one row per pose");
+            }
+            IkOptions o;
+            o.positionTolerance = positionTolerance;
+            o.orientationTolerance = orientationTolerance;
+            o.maxAttempts = maxAttempts;
+            py::array_t<double> out({rows, py::ssize_t{n}});
+            py::array_t<bool> solved(rows);
+            double* qo = out.mutable_data();
+            bool* so = solved.mutable_data();
+            {
+              py::gil_scoped_release release;
+              ManipulatorData data(*p.model);
+              JointVector q(n);
+              for (py::ssize_t r = 0; r < rows; ++r) {
+                const JointVector start = seeds.is_none() ? p.model->getHomePosition() : row(seed, r, n);
+                so[r] = inverseKinematics(*p.model, data, targets[static_cast<std::size_t>(r)], start, q, o) == IkStatus::Solved;
+                for (int i = 0; i < n; ++i) qo[r * n + i] = q(i);
+              }
+            }
+            return py::make_tuple(solved, out);
+          },
+          py::arg("poses"), py::arg("seeds") = py::none(), py::arg("position_tolerance") = 1e-6,
+          py::arg("orientation_tolerance") = 1e-6, py::arg("max_attempts") = 100,
+          "numeric ik of every pose of an N x 4 x 4 array: (solved: N booleans, q: N x dof)")
       .def(
           "crba_batch",
           [](const PyModel& p, const py::handle& qs, bool motorInertia) {

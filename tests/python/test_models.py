@@ -74,6 +74,7 @@ def test_batched_calls_equal_single_calls(make):
     Q, QD, QDD = random_q(model, rng, 50), rng.uniform(-1, 1, (50, model.dof)), rng.uniform(-1, 1, (50, model.dof))
     fk, J, tau, M, acc = (model.fk_batch(Q), model.jacobian_batch(Q), model.rnea_batch(Q, QD, QDD), model.crba_batch(Q),
                           model.aba_batch(Q, QD, QDD))
+    g = model.gravity_torque_batch(Q)
     assert fk.shape == (50, 4, 4) and J.shape == (50, 6, model.dof) and M.shape == (50, model.dof, model.dof)
     for k in range(50):
         np.testing.assert_array_equal(fk[k], model.fk(Q[k]))
@@ -81,6 +82,7 @@ def test_batched_calls_equal_single_calls(make):
         np.testing.assert_array_equal(tau[k], model.rnea(Q[k], QD[k], QDD[k]))
         np.testing.assert_array_equal(M[k], model.crba(Q[k]))
         np.testing.assert_array_equal(acc[k], model.aba(Q[k], QD[k], QDD[k]))
+        np.testing.assert_array_equal(g[k], model.gravity_torque(Q[k]))
 
 
 def test_batched_calls_in_threads_give_the_same_results():
@@ -129,6 +131,20 @@ def test_numeric_ik_solves_reachable_wam_poses():
         assert status == "solved"
         np.testing.assert_allclose(wam.fk(q), pose, atol=1e-5)
         assert wam.within_limits(q)
+
+
+def test_batched_ik_solves_each_pose_like_the_single_call():
+    wam = rp.WAMModel(7)
+    rng = np.random.default_rng(8)
+    poses = wam.fk_batch(random_q(wam, rng, 4))
+    solved, Q = wam.ik_batch(poses)
+    assert solved.dtype == bool and solved.all()
+    for k in range(4):
+        np.testing.assert_allclose(wam.fk(Q[k]), poses[k], atol=1e-5)
+        status, q = wam.ik(poses[k])
+        np.testing.assert_array_equal(Q[k], q)
+    with pytest.raises(ValueError, match=r"poses\[1\]: not a rigid transform"):
+        wam.ik_batch(np.stack([np.eye(4), 2 * np.eye(4)]))
 
 
 def test_bad_input_is_a_clear_python_exception():
