@@ -406,23 +406,29 @@ TEST_F(ManipulatorTest, ATrajectoryGeneratorAndAServoControlTakeOverFromWhereThe
   struct FirstSetpoint : TrajectoryGenerator {
     ~FirstSetpoint() override { releaseFromManipulators(); }
     bool getCurrentSetpoint(double, Setpoint& sp) override {
-      if (first.size() == 0) first = sp.position;
+      if (!recorded.load(std::memory_order_relaxed)) {
+        first = sp.position;
+        recorded.store(true, std::memory_order_release);  // the test reads `first` after this
+      }
       return false;  // hold
     }
     JointVector first;
+    std::atomic<bool> recorded{false};
   };
   struct Tracker : ServoControl {  // PD on the setpoint; records the first one it sees
     ~Tracker() override { releaseFromManipulator(); }
     void calculate() override {
       Manipulator& m = *d_manipulator;
-      if (first.size() == 0) {
+      if (!recorded.load(std::memory_order_relaxed)) {
         first = m.getSetpoint().position;
         qAtFirst = m.getJointPosition();
+        recorded.store(true, std::memory_order_release);  // the test reads them after this
       }
       const JointVector tau = 400.0 * (m.getSetpoint().position - m.getJointPosition()) - 40.0 * m.getJointVelocity();
       m.setControlOutput(tau);
     }
     JointVector first, qAtFirst;
+    std::atomic<bool> recorded{false};
   };
   Puma560 puma;
   simClock().pause();
@@ -437,6 +443,7 @@ TEST_F(ManipulatorTest, ATrajectoryGeneratorAndAServoControlTakeOverFromWhereThe
   puma.setServoControl(tracker);
   puma.setZeroGravityModeOff();
   ASSERT_TRUE(puma.runCycles(2));
+  ASSERT_TRUE(tracker.recorded.load(std::memory_order_acquire));
   const JointVector held = tracker.qAtFirst;
   ASSERT_EQ(tracker.first.size(), 6);
   EXPECT_LT((tracker.first - held).cwiseAbs().maxCoeff(), 1e-12) << "the new control's first setpoint is where the arm is";
@@ -445,6 +452,7 @@ TEST_F(ManipulatorTest, ATrajectoryGeneratorAndAServoControlTakeOverFromWhereThe
   FirstSetpoint generator;
   puma.setTrajectoryGenerator(generator);
   ASSERT_TRUE(puma.runCycles(2));
+  ASSERT_TRUE(generator.recorded.load(std::memory_order_acquire));
   ASSERT_EQ(generator.first.size(), 6);
   EXPECT_LT((generator.first - held).cwiseAbs().maxCoeff(), 1e-12) << "the generator starts where the arm was held";
   ASSERT_TRUE(puma.runCycles(1000));
