@@ -374,6 +374,35 @@ Configuration Configuration::read(const std::string& fileName, const Options& op
   return parse(internal::readTextFile(fileName), fileName, options);
 }
 
+namespace {
+// The paper's vector form (Table 1: `position <x,y,z>`): `<300, 0, 0>` gives the values 300, 0, 0.
+std::vector<std::string> angleBracketValues(const std::string& text, const std::string& name, const std::string& fileName,
+                                            int line) {
+  const std::size_t open = text.find('<');
+  const std::size_t close = text.rfind('>');
+  if (close == std::string::npos || close < open)
+    throw ConfigError(fileName, line, "setting '" + ex(name) + "': '<' without a closing '>'");
+  if (text.find_first_not_of(" \t\r\f\v", close + 1) != std::string::npos)
+    throw ConfigError(fileName, line, "setting '" + ex(name) + "': unexpected text after '>'");
+  std::vector<std::string> values;
+  std::size_t start = open + 1;
+  while (true) {
+    const std::size_t comma = std::min(text.find(',', start), close);
+    std::string value = text.substr(start, comma - start);
+    const std::size_t b = value.find_first_not_of(" \t\r\f\v");
+    const std::size_t e = value.find_last_not_of(" \t\r\f\v");
+    value = b == std::string::npos ? std::string() : value.substr(b, e - b + 1);
+    if (value.empty() || value.find_first_of(" \t<>") != std::string::npos)
+      throw ConfigError(fileName, line, "setting '" + ex(name) + "': '" + ex(text.substr(open, close - open + 1)) +
+                                            "' is not a list of values like <x,y,z>");
+    values.push_back(value);
+    if (comma == close) break;
+    start = comma + 1;
+  }
+  return values;
+}
+}  // namespace
+
 Configuration Configuration::parse(const std::string& text, const std::string& fileName, const Options& options) {
   Configuration cfg;
   cfg.fileName_ = fileName;
@@ -424,6 +453,8 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
     }
     const std::string& name = line.words[0];
     ConfigSetting setting{name, {line.words.begin() + 1, line.words.end()}, line.number};
+    if (!setting.values.empty() && setting.values.front().front() == '<')
+      setting.values = angleBracketValues(line.trimmed.substr(name.size()), name, fileName, line.number);
     if (!current) {
       if (name == "plugin") {
         if (setting.values.size() != 1)

@@ -68,6 +68,16 @@ TEST(Configuration, CommentsBlankLinesCrLfAndSigns) {
   EXPECT_EQ(arm->find("orientation")->line, 6);
 }
 
+TEST(Configuration, ThePapersVectorFormGivesTheSameValues) {
+  // Table 1 writes `position <x,y,z> orientation <r,p,y>`; spaces after the commas are allowed.
+  const Configuration cfg = Configuration::parse(
+      "[secondrobot]\nclass TestArm\nposition <300,0, -12.5>\norientation < 0 , 0 , 90 >\n", "rp.cfg");
+  const ConfigSection* s = cfg.findSection("secondrobot");
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(s->getNumbers("position"), (std::vector<double>{300, 0, -12.5}));
+  EXPECT_EQ(s->getNumbers("orientation"), (std::vector<double>{0, 0, 90}));
+}
+
 TEST(Configuration, EmptyFileHasNoSections) {
   EXPECT_TRUE(Configuration::parse("").sections().empty());
   EXPECT_TRUE(Configuration::parse("\n# only comments\n\n").sections().empty());
@@ -130,6 +140,14 @@ INSTANTIATE_TEST_SUITE_P(
                   "rp.cfg:3: setting 'positon' is not known for class TestArm (known: " + kArmSettings + ")"},
         Malformed{"[a]\nclass TestArm\nposition 1 2\n",
                   "rp.cfg:3: setting 'position' needs 3 values (x y z [mm]), got 2"},
+        Malformed{"[a]\nclass TestArm\nposition <1, 2>\n",
+                  "rp.cfg:3: setting 'position' needs 3 values (x y z [mm]), got 2"},
+        Malformed{"[a]\nclass TestArm\nposition <1, 2, 3\n", "rp.cfg:3: setting 'position': '<' without a closing '>'"},
+        Malformed{"[a]\nclass TestArm\nposition <1,,3>\n",
+                  "rp.cfg:3: setting 'position': '<1,,3>' is not a list of values like <x,y,z>"},
+        Malformed{"[a]\nclass TestArm\nposition <1 2 3>\n",
+                  "rp.cfg:3: setting 'position': '<1 2 3>' is not a list of values like <x,y,z>"},
+        Malformed{"[a]\nclass TestArm\nposition <1,2,3> 4\n", "rp.cfg:3: setting 'position': unexpected text after '>'"},
         Malformed{"[a]\nclass TestArm\nposition 1 2 3 4\n",
                   "rp.cfg:3: setting 'position' needs 3 values (x y z [mm]), got 4"},
         Malformed{"[a]\nclass TestArm\norientation 1,2,3\n",
