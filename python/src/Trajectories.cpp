@@ -1,5 +1,6 @@
 // Trajectories planned and sampled in Python without an arm: the library's jerk-limited joint
-// motion (JointLineSegment, the same profile as TrajectoryGenerator.move) through waypoints.
+// motion (JointLineSegment) through waypoints, and the default generator's joint, Cartesian and
+// blended motions (OfflinePlanner).
 #include <pybind11/pybind11.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 #include "Arrays.hpp"
 #include "Bindings.hpp"
 #include "rp/trajectory/JointLineSegment.hpp"
+#include "rp/trajectory/OfflinePlanner.hpp"
 
 namespace rp::python {
 
@@ -70,6 +72,52 @@ void bindTrajectories(py::module_& m) {
       "Plans rest-to-rest jerk-limited joint motions through the rows of `waypoints` (K x dof, the first row the "
       "start) within the model's velocity, acceleration and jerk limits (scaled in time by speed_fraction), and "
       "samples them at `rate` Hz: a dict of time (N), q, qd, qdd (N x dof) and duration [s].");
+
+  py::class_<OfflinePlanner>(m, "Planner",
+                             "The default trajectory generator's motions planned for a model alone and sampled: queue "
+                             "motions as on rp.TrajectoryGenerator (move, move_radians, move_to, dwell, blend radii, "
+                             "speed fraction), then sample(rate).")
+      .def(py::init([](const py::handle& modelObject, const py::object& start) {
+             const ManipulatorModel& model = modelOf(modelObject);
+             const JointVector q = start.is_none() ? model.getHomePosition()
+                                                   : toVector(start, model.getNumberOfJoints(), "start");
+             return std::make_unique<OfflinePlanner>(model, q);
+           }),
+           py::arg("model"), py::arg("start") = py::none())
+      .def("move", [](OfflinePlanner& p, const py::handle& degrees) {
+             auto& g = p.generator();
+             g.move(toVector(degrees, p.getModel().getNumberOfJoints(), "target_degrees"));
+           }, py::arg("target_degrees"))
+      .def("move_radians", [](OfflinePlanner& p, const py::handle& q) {
+             auto& g = p.generator();
+             g.moveRadians(toVector(q, p.getModel().getNumberOfJoints(), "target"));
+           }, py::arg("target"))
+      .def("move_to", [](OfflinePlanner& p, const py::handle& pose) { p.generator().moveTo(toTransform(pose, "pose")); },
+           py::arg("pose"))
+      .def("move_to_through_joint_space",
+           [](OfflinePlanner& p, const py::handle& pose) { p.generator().moveToThroughJointSpace(toTransform(pose, "pose")); },
+           py::arg("pose"))
+      .def("dwell", &OfflinePlanner::dwell, py::arg("seconds"))
+      .def("set_joint_blend_radius", [](OfflinePlanner& p, double r) { p.generator().setJointBlendRadius(r); },
+           py::arg("radians"))
+      .def("set_cartesian_blend_radius", [](OfflinePlanner& p, double r) { p.generator().setCartesianBlendRadius(r); },
+           py::arg("metres"))
+      .def("set_speed_fraction", [](OfflinePlanner& p, double f) { p.generator().setSpeedFraction(f); },
+           py::arg("fraction"))
+      .def(
+          "sample",
+          [](OfflinePlanner& p, double rate) {
+            const OfflinePlanner::Samples s = p.sample(rate);
+            py::dict out;
+            out["time"] = fromVector(Eigen::Map<const Eigen::VectorXd>(s.time.data(), static_cast<Eigen::Index>(s.time.size())));
+            out["q"] = fromMatrix(s.q);
+            out["qd"] = fromMatrix(s.qd);
+            out["qdd"] = fromMatrix(s.qdd);
+            out["duration"] = s.duration;
+            return out;
+          },
+          py::arg("rate") = 1000.0,
+          "the queued motions sampled at `rate` Hz: dict of time, q, qd, qdd and duration (the first sample after the end)");
 }
 
 }  // namespace rp::python

@@ -228,3 +228,31 @@ def test_a_planned_joint_motion_is_time_optimal_within_the_limits_and_consistent
         rp.plan_joint_motion(puma, start[None, :])
     with pytest.raises(ValueError, match="speed_fraction"):
         rp.plan_joint_motion(puma, np.vstack([start, target]), speed_fraction=2)
+
+
+def test_the_planner_samples_the_generators_cartesian_and_blended_motions():
+    puma = rp.Puma560Model()
+    start = np.array([0.2, -0.3, 0.8, 0.3, -0.7, 0.1])
+    a = puma.fk(start)
+    b = a.copy()
+    b[:3, 3] += [0.1, -0.1, -0.05]
+    planner = rp.Planner(puma, start)
+    planner.move_to(b)
+    s = planner.sample(500)
+    tips = puma.fk_batch(s["q"])[:, :3, 3]
+    along = (b[:3, 3] - a[:3, 3]) / np.linalg.norm(b[:3, 3] - a[:3, 3])
+    off = (tips - a[:3, 3]) - np.outer((tips - a[:3, 3]) @ along, along)
+    assert np.abs(off).max() < 1e-6, "the end-effector stays on the straight line"
+    np.testing.assert_allclose(puma.fk(s["q"][-1]), b, atol=1e-6)
+    assert s["time"][0] == 0 and s["duration"] == s["time"][-1]
+
+    def via_plan(radius):
+        p = rp.Planner(puma)
+        p.set_joint_blend_radius(radius)
+        p.move_radians(puma.home + [0.5, 0, 0, 0, 0, 0])
+        p.move_radians(puma.home + [0.5, -0.5, 0, 0, 0, 0])
+        return p.sample(1000)
+
+    assert via_plan(0.1)["duration"] < via_plan(0.0)["duration"] - 0.05
+    with pytest.raises(ValueError, match="outside the limits"):
+        rp.Planner(puma).move_radians(puma.home + [0, 1, 0, 0, 0, 0])

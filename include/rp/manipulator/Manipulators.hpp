@@ -12,5 +12,6 @@
 #include "rp/manipulator/WAM.hpp"
 #include "rp/trajectory/DefaultTrajectoryGenerator.hpp"
 #include "rp/trajectory/JerkLimitedProfile.hpp"
+#include "rp/trajectory/OfflinePlanner.hpp"
 #include "rp/trajectory/QueueTrajectoryGenerator.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
