@@ -37,7 +37,7 @@ std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, const std::st
   std::vector<LinkParameters> links;
   for (int i = 0; i < m->getNumberOfJoints(); ++i) links.push_back(m->getLink(i));
   return std::make_unique<ManipulatorModel>(m->getName(), links, Transform(base * m->getBaseTransform()),
-                                            m->getToolTransform());
+                                            m->getToolTransform(), m->getGravity(), m->getConvention());
 }
 }  // namespace
 

@@ -34,7 +34,7 @@ std::string toUrdf(const ManipulatorModel& model) {
   for (int k = 0; k < n; ++k) {
     const LinkParameters& l = model.getLink(k);
     const Transform fixed = zRotation(l.offset) * translation(0, 0, l.d);
-    const Transform pre = standard ? fixed : Transform(xRotation(l.alpha) * translation(l.a, 0, 0) * fixed);
+    const Transform pre = standard ? fixed : model.getPlacement(k);
     const Transform post = standard ? Transform(translation(l.a, 0, 0) * xRotation(l.alpha)) : Transform::unit();
     const std::string link = "link" + std::to_string(k + 1);
     x << "  <link name=\"" << link << "\">\n    <inertial>\n      " << origin(Transform(post * translation(l.com)))

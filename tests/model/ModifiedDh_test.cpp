@@ -8,6 +8,7 @@
 #include <random>
 
 #include "ModifiedDh.hpp"
+#include "PrismaticDhArm.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/Puma560Model.hpp"
@@ -71,9 +72,7 @@ TEST(ModifiedDh, Puma560SameAsStandard) { compare(Puma560Model(), 1000); }
 TEST(ModifiedDh, Wam7SameAsStandard) { compare(WAM7Model(), 1000); }
 
 TEST(ModifiedDh, PrismaticArmSameAsStandard) {
-  UrdfOptions o;
-  o.tip = "tool";
-  const std::unique_ptr<ManipulatorModel> arm = loadUrdf(std::string(RP_TEST_DATA_DIR) + "/prismatic_arm.urdf", o);
+  const std::unique_ptr<ManipulatorModel> arm = test::prismaticDhArm();
   // Its last DH link has a non-zero a or alpha, so link frame n (where a tip wrench acts) differs
   // between the conventions: compare without one.
   compare(*arm, 1000, false);
