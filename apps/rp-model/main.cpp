@@ -147,7 +147,10 @@ int run(int argc, char** argv) {
     UrdfOptions urdf;
     if (opts.count("--tip")) urdf.tip = opts.at("--tip");
     urdf.requireDynamics = command == "gravity" || command == "rnea" || command == "inertia" || command == "fd";
+    std::vector<std::string> notes;
+    urdf.notes = &notes;
     model = loadUrdf(robot, urdf);
+    for (const std::string& note : notes) std::cerr << "rp-model: note: " << note << std::endl;
   } else {
     throw UsageError("unknown robot '" + robot + "' (known: puma560, wam4, wam7, or a .urdf file)");
   }

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -390,6 +391,101 @@ void selfCheck(const ManipulatorModel& model, const std::vector<urdf::JointConst
   }
 }
 
+bool isMovable(const urdf::Joint& j) {
+  return j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS || j.type == urdf::Joint::PRISMATIC;
+}
+
+// Whether a name suggests a gripper's joint or link.
+bool looksLikeGripper(std::string name) {
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* word : {"grip", "finger", "jaw", "claw"})
+    if (name.find(word) != std::string::npos) return true;
+  return false;
+}
+
+bool isGripperJoint(const urdf::Joint& j) { return looksLikeGripper(j.name) || looksLikeGripper(j.child_link_name); }
+
+// The default tip: from the root, follow the one child joint whose subtree moves (a branch that
+// carries only fixed frames, such as tool0 or a camera, is no branch) to the last moving link.
+// Where everything that moves further on is a gripper (joints or links named grip..., finger,
+// jaw, claw), the arm ends there and the gripper is lumped (see loadUrdf()). Two or more other
+// moving subtrees are a real choice: refused, listing the leaf links below as candidate tips.
+urdf::LinkConstSharedPtr defaultTip(const urdf::ModelInterface& robot, const urdf::LinkConstSharedPtr& root,
+                                    const std::string& fileName) {
+  // Links with a movable joint somewhere below them, and with one that is not a gripper's, marked
+  // upwards from each movable joint (each link is marked once).
+  std::unordered_set<const urdf::Link*> movesBelow, armBelow;
+  auto markUp = [&](const urdf::Joint& joint, std::unordered_set<const urdf::Link*>& marks) {
+    for (urdf::LinkConstSharedPtr link = robot.getLink(joint.parent_link_name); link && marks.insert(link.get()).second;
+         link = link->parent_joint ? robot.getLink(link->parent_joint->parent_link_name) : nullptr) {
+    }
+  };
+  // (Floating and planar joints count as moving, so that a chain through one is refused by name.)
+  auto moving = [](const urdf::Joint& j) { return j.type != urdf::Joint::FIXED; };
+  for (const auto& [name, joint] : robot.joints_) {
+    if (!joint || !moving(*joint)) continue;
+    markUp(*joint, movesBelow);
+    if (!isGripperJoint(*joint)) markUp(*joint, armBelow);
+  }
+  auto below = [&](const urdf::JointConstSharedPtr& j, const std::unordered_set<const urdf::Link*>& marks) {
+    const urdf::LinkConstSharedPtr child = robot.getLink(j->child_link_name);
+    return child && marks.count(child.get()) > 0;
+  };
+  urdf::LinkConstSharedPtr link = root, lastMoving;
+  for (;;) {
+    std::vector<urdf::JointConstSharedPtr> branches;
+    bool arm = false;  // something that is not a gripper moves further on
+    for (const urdf::JointSharedPtr& c : link->child_joints) {
+      if (!c || !(moving(*c) || below(c, movesBelow))) continue;
+      branches.push_back(c);
+      arm = arm || (moving(*c) && !isGripperJoint(*c)) || below(c, armBelow);
+    }
+    if (branches.empty() || !arm) break;
+    if (branches.size() > 1) {
+      std::vector<std::string> leaves;
+      std::vector<urdf::LinkConstSharedPtr> todo{link};
+      while (!todo.empty()) {
+        const urdf::LinkConstSharedPtr l = todo.back();
+        todo.pop_back();
+        if (l->child_joints.empty()) leaves.push_back(l->name);
+        for (const urdf::JointSharedPtr& c : l->child_joints)
+          if (c) todo.push_back(robot.getLink(c->child_link_name));
+      }
+      std::sort(leaves.begin(), leaves.end());
+      std::string list;
+      for (std::size_t i = 0; i < leaves.size() && i < 12; ++i) {
+        if (i > 0) list += ", ";
+        list += '\'';  // piece by piece: GCC 12 warns (-Wrestrict) about "'" + s
+        list += excerpt(leaves[i]);
+        list += '\'';
+      }
+      if (leaves.size() > 12) list += ", ...";
+      throw UrdfError(fileName + ": the robot branches at link '" + excerpt(link->name) + "' into " +
+                      std::to_string(branches.size()) + " moving chains; name the tip link, one of " + list);
+    }
+    const urdf::JointConstSharedPtr j = branches.front();
+    link = robot.getLink(j->child_link_name);
+    if (moving(*j)) lastMoving = link;
+  }
+  return lastMoving ? lastMoving : link;
+}
+
+// Every mimic joint names an existing joint other than itself, with a finite multiplier and
+// offset, and mimics do not go round in a circle.
+void checkMimics(const urdf::ModelInterface& robot, const std::string& fileName) {
+  for (const auto& [name, joint] : robot.joints_) {
+    if (!joint || !joint->mimic) continue;
+    const std::string where = fileName + ": joint '" + excerpt(name) + "' mimics ";
+    const urdf::JointMimic& m = *joint->mimic;
+    if (!robot.getJoint(m.joint_name)) throw UrdfError(where + "joint '" + excerpt(m.joint_name) + "', which does not exist");
+    if (!std::isfinite(m.multiplier) || !std::isfinite(m.offset))
+      throw UrdfError(where + "'" + excerpt(m.joint_name) + "' with a multiplier or offset that is not finite");
+    std::unordered_set<std::string> seen{name};
+    for (urdf::JointConstSharedPtr j = robot.getJoint(m.joint_name); j && j->mimic; j = robot.getJoint(j->mimic->joint_name))
+      if (!seen.insert(j->name).second) throw UrdfError(where + "'" + excerpt(m.joint_name) + "': the mimic joints go round in a circle");
+  }
+}
+
 // urdfdom links children with shared pointers: a long chain would be freed by one recursive
 // destructor call per link (a stack overflow for 100,000 links) and a loop would never be freed.
 // Dropping those pointers first leaves each link to be freed alone by the model's own maps.
@@ -413,6 +509,7 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
   const urdf::LinkConstSharedPtr root = robot->getRoot();
   if (!root) throw UrdfError(fileName + ": the robot has no root link");
   checkTree(*robot, *root, fileName);
+  checkMimics(*robot, fileName);
 
   // The chain of joints from the root to the tip.
   urdf::LinkConstSharedPtr tip;
@@ -420,18 +517,7 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     tip = robot->getLink(options.tip);
     if (!tip) throw UrdfError(fileName + ": there is no link '" + options.tip + "'");
   } else {
-    urdf::LinkConstSharedPtr link = root, lastMovable;
-    while (!link->child_joints.empty()) {
-      if (link->child_joints.size() > 1) {
-        throw UrdfError(fileName + ": the robot branches at link '" + link->name + "'; name the tip link");
-      }
-      const urdf::JointConstSharedPtr j = link->child_joints.front();
-      link = robot->getLink(j->child_link_name);
-      if (j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS || j->type == urdf::Joint::PRISMATIC) {
-        lastMovable = link;
-      }
-    }
-    tip = lastMovable ? lastMovable : link;
+    tip = defaultTip(*robot, root, fileName);
   }
   std::vector<urdf::JointConstSharedPtr> chain;
   for (urdf::LinkConstSharedPtr link = tip; link->parent_joint; link = robot->getLink(link->parent_joint->parent_link_name)) {
@@ -447,31 +533,88 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
   Transform C = Transform::unit();
   std::unordered_set<std::string> chainLinks;
   for (const urdf::JointConstSharedPtr& j : chain) chainLinks.insert(j->child_link_name);
-  // A link's inertia and that of everything fixed to it off the chain (e.g. a camera), walked
-  // with an explicit stack: a chain of many fixed links must not recurse once per link.
-  std::vector<std::pair<urdf::LinkConstSharedPtr, Transform>> pending;
+  // The value at which a moving joint off the chain is lumped: the user's, its master's for a
+  // mimic joint (multiplier and offset), or zero within its limits.
+  auto offChainValue = [&](const urdf::Joint& joint) {
+    const urdf::Joint* j = &joint;
+    double multiplier = 1, offset = 0;
+    for (std::size_t depth = 0; depth <= robot->joints_.size(); ++depth) {
+      if (const auto it = options.offChainPositions.find(j->name); it != options.offChainPositions.end())
+        return multiplier * it->second + offset;
+      if (!j->mimic) break;
+      offset += multiplier * j->mimic->offset;
+      multiplier *= j->mimic->multiplier;
+      j = robot->getJoint(j->mimic->joint_name).get();
+    }
+    double v = 0;
+    if (j->limits && j->type != urdf::Joint::CONTINUOUS) v = std::clamp(0.0, j->limits->lower, j->limits->upper);
+    return multiplier * v + offset;
+  };
+  for (const auto& [name, value] : options.offChainPositions) {
+    if (!robot->getJoint(name)) throw UrdfError(fileName + ": UrdfOptions::offChainPositions: there is no joint '" + excerpt(name) + "'");
+    if (!std::isfinite(value))
+      throw UrdfError(fileName + ": UrdfOptions::offChainPositions: joint '" + excerpt(name) + "': the value is not finite");
+  }
+  // A link's inertia and that of everything hanging on it off the chain: fixed (a camera) or
+  // moving (fingers, a jaw: at offChainValue(), reported in a note), walked with an explicit
+  // stack: a chain of many fixed links must not recurse once per link.
+  struct Pending {
+    urdf::LinkConstSharedPtr link;
+    Transform pose;
+    bool moved;  // below a moving joint off the chain
+  };
+  std::vector<Pending> pending;
   auto addInertial = [&](const urdf::LinkConstSharedPtr& start, const Transform& startPose) {
     if (links.empty()) return;  // links before the first joint belong to the base
+    std::string movedLinks, movingJoints;
     pending.clear();
-    pending.emplace_back(start, startPose);
+    pending.push_back({start, startPose, false});
     while (!pending.empty()) {
-      const urdf::LinkConstSharedPtr link = pending.back().first;
-      const Transform pose = pending.back().second;
+      const Pending p = pending.back();
       pending.pop_back();
-      if (link->inertial) {
-        const Transform in = Transform(pose * toTransform(link->inertial->origin));
+      if (p.link->inertial) {
+        const Transform in = Transform(p.pose * toTransform(p.link->inertial->origin));
         const Eigen::Matrix3d R = in.topLeftCorner<3, 3>();
         Eigen::Matrix3d I;
-        const urdf::Inertial& i = *link->inertial;
+        const urdf::Inertial& i = *p.link->inertial;
         I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
         links.back().body.add(i.mass, in.topRightCorner<3, 1>(), R * I * R.transpose());
       }
-      for (const urdf::JointSharedPtr& c : link->child_joints) {
-        if (c->type != urdf::Joint::FIXED) continue;
+      for (const urdf::JointSharedPtr& c : p.link->child_joints) {
         if (chainLinks.count(c->child_link_name)) continue;
-        pending.emplace_back(robot->getLink(c->child_link_name),
-                             Transform(pose * toTransform(c->parent_to_joint_origin_transform)));
+        if (c->type != urdf::Joint::FIXED && !isMovable(*c)) continue;  // a floating or planar body is not carried
+        if (!finite(c->parent_to_joint_origin_transform))
+          throw UrdfError(fileName + ": joint '" + excerpt(c->name) + "' has an origin that is not finite");
+        Transform child = Transform(p.pose * toTransform(c->parent_to_joint_origin_transform));
+        if (isMovable(*c)) {
+          const V3 axis = V3(c->axis.x, c->axis.y, c->axis.z);
+          if (!axis.allFinite() || axis.norm() < 1e-12)
+            throw UrdfError(fileName + ": joint '" + excerpt(c->name) + "' has an axis that is zero or not finite");
+          const double v = offChainValue(*c);
+          Transform motion = Transform::unit();
+          if (c->type == urdf::Joint::PRISMATIC) motion.topRightCorner<3, 1>() = v * axis.normalized();
+          else motion.topLeftCorner<3, 3>() = Eigen::AngleAxisd(v, axis.normalized()).toRotationMatrix();
+          child = Transform(child * motion);
+          char value[64];
+          std::snprintf(value, sizeof value, " = %g", v);
+          if (!movingJoints.empty()) movingJoints += ", ";
+          movingJoints += excerpt(c->name);
+          movingJoints += value;
+        }
+        const bool moved = p.moved || isMovable(*c);
+        if (moved) {
+          if (!movedLinks.empty()) movedLinks += ", ";
+          movedLinks += '\'';  // piece by piece: GCC 12 warns (-Wrestrict) about "'" + s
+          movedLinks += excerpt(c->child_link_name);
+          movedLinks += '\'';
+        }
+        pending.push_back({robot->getLink(c->child_link_name), child, moved});
       }
+    }
+    if (!movedLinks.empty() && options.notes) {
+      options.notes->push_back(fileName + ": links " + movedLinks + " move off the chain: their mass is lumped into '" +
+                               excerpt(links.back().joint->child_link_name) + "' at " + movingJoints +
+                               " (UrdfOptions::offChainPositions sets other values)");
     }
   };
   for (const urdf::JointConstSharedPtr& j : chain) {
@@ -482,6 +625,10 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
       case urdf::Joint::REVOLUTE:
       case urdf::Joint::CONTINUOUS:
       case urdf::Joint::PRISMATIC: {
+        if (j->mimic)
+          throw UrdfError(joint + " mimics joint '" + excerpt(j->mimic->joint_name) +
+                          "': a mimic joint is no independent joint of the arm, and mimic joints on the chain are not "
+                          "supported; name a tip link before it (links moved by mimic joints off the chain are lumped)");
         V3 axis(j->axis.x, j->axis.y, j->axis.z);
         if (!axis.allFinite()) throw UrdfError(joint + " has an axis that is not finite");
         if (axis.norm() < 1e-12) throw UrdfError(joint + " has a zero axis");

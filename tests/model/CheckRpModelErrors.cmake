@@ -26,7 +26,11 @@ set(cases
   "--robot wam7 ik --pose 1,0,0,nan,0,1,0,0,0,0,1,0.5,0,0,0,1"
   # Issue 19: URDF files with a kinematic loop (used to hang) or a NaN mass (used to load).
   "--robot ${DATA}/kinematic_loop.urdf fk --q 0,0"
-  "--robot ${DATA}/nan_mass.urdf gravity --q 0")
+  "--robot ${DATA}/nan_mass.urdf gravity --q 0"
+  # Issue 20: joint values by name: an unknown name, a joint left out, names mixed with positions.
+  "--robot ${DATA}/ur_like.urdf fk --q nosuch_joint=0"
+  "--robot puma560 fk --q joint1=0,joint2=0"
+  "--robot puma560 fk --q joint1=0,0,0,0,0,0")
 set(count 0)
 foreach(args IN LISTS cases)
   set(shown "${args}")
@@ -40,6 +44,6 @@ foreach(args IN LISTS cases)
   message("rp-model ${shown} -> ${err}")
   math(EXPR count "${count} + 1")
 endforeach()
-if(NOT count EQUAL 22)
-  message(FATAL_ERROR "${count} cases ran, expected 22")
+if(NOT count EQUAL 25)
+  message(FATAL_ERROR "${count} cases ran, expected 25")
 endif()

@@ -67,6 +67,13 @@ struct KdlArm {
   bool allInertial = true;  // the child link of every movable joint has inertial data
 };
 
+// The value at which a moving joint off the chain is lumped: zero within its limits, or for a
+// mimic joint its master's times the multiplier plus the offset.
+double offChainValue(const urdf::ModelInterfaceSharedPtr& robot, const urdf::JointConstSharedPtr& j) {
+  if (j->mimic) return j->mimic->multiplier * offChainValue(robot, robot->getJoint(j->mimic->joint_name)) + j->mimic->offset;
+  return j->limits && j->type != urdf::Joint::CONTINUOUS ? std::clamp(0.0, j->limits->lower, j->limits->upper) : 0.0;
+}
+
 KdlArm kdlArm(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip) {
   std::vector<urdf::JointConstSharedPtr> joints;
   for (auto link = robot->getLink(tip); link->parent_joint; link = robot->getLink(link->parent_joint->parent_link_name))
@@ -88,9 +95,19 @@ KdlArm kdlArm(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip
         inertia = inertia + frame * kdlInertia(*link->inertial);
         any = true;
       }
-      for (const urdf::JointSharedPtr& c : link->child_joints)
-        if (c->type == urdf::Joint::FIXED && !onChain.count(c->child_link_name))
-          todo.emplace_back(robot->getLink(c->child_link_name), frame * test::kdlFrame(pose(c->parent_to_joint_origin_transform)));
+      for (const urdf::JointSharedPtr& c : link->child_joints) {
+        if (onChain.count(c->child_link_name)) continue;
+        const KDL::Frame o = test::kdlFrame(pose(c->parent_to_joint_origin_transform));
+        if (c->type == urdf::Joint::FIXED) {
+          todo.emplace_back(robot->getLink(c->child_link_name), frame * o);
+        } else if (c->type != urdf::Joint::FLOATING && c->type != urdf::Joint::PLANAR) {
+          // A moving link off the chain (a finger, a jaw), lumped at its stated value.
+          KDL::Vector axis = o.M * KDL::Vector(c->axis.x, c->axis.y, c->axis.z);
+          axis = axis / axis.Norm();
+          const KDL::Joint joint(c->name, o.p, axis, c->type == urdf::Joint::PRISMATIC ? KDL::Joint::TransAxis : KDL::Joint::RotAxis);
+          todo.emplace_back(robot->getLink(c->child_link_name), frame * KDL::Segment(joint, o).pose(offChainValue(robot, c)));
+        }
+      }
     }
     if (j->type == urdf::Joint::FIXED) {
       arm.chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, KDL::Joint::Fixed), origin, inertia));
@@ -211,6 +228,8 @@ TEST(UrdfExactness, ArmsWithFixedFrameBranchesAndPrismaticJointsLoadExactly) {
   expectExact("ur_like.urdf", "camera_link", 6);
   expectExact("panda_like.urdf", "hand_tcp", 7);
   expectExact("test_arm.urdf", "tool", 6);
+  expectExact("panda_like.urdf", "link7", 7);  // the hand and the fingers (one a mimic) lumped
+  expectExact("jaw_arm.urdf", "link06", 6);    // the jaw lumped
   expectExact("prismatic_arm.urdf", "tool", 6);
 }
 
