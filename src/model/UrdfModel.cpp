@@ -244,6 +244,38 @@ void checkInertials(const TiXmlElement* robot, const std::string& fileName) {
   }
 }
 
+// Checks the numbers of every joint in the XML itself: urdfdom refuses a joint whose <limit> holds
+// `nan` with "not a valid URDF document", naming neither the joint nor the value.
+void checkJointNumbers(const TiXmlElement* robot, const std::string& fileName) {
+  for (const TiXmlElement* joint = robot->FirstChildElement("joint"); joint; joint = joint->NextSiblingElement("joint")) {
+    const char* nameAttribute = joint->Attribute("name");
+    const std::string where = fileName + ": joint '" + excerpt(nameAttribute ? nameAttribute : "") + "': <";
+    auto quoted = [](const TiXmlElement* e, const char* name) {
+      std::string q(1, '\'');  // appended piece by piece: GCC 12 warns (-Wrestrict) about "'" + s
+      q += excerpt(e->Attribute(name));
+      q += '\'';
+      return q;
+    };
+    for (const char* element : {"origin", "axis"}) {
+      const TiXmlElement* e = joint->FirstChildElement(element);
+      for (const char* name : {"xyz", "rpy"})
+        if (e && !finiteTriple(e, name))
+          throw UrdfError(where + element + "> " + name + " " + quoted(e, name) + " is not three finite numbers");
+    }
+    const std::pair<const char*, std::vector<const char*>> numbers[] = {
+        {"limit", {"lower", "upper", "effort", "velocity"}}, {"dynamics", {"damping", "friction"}}, {"mimic", {"multiplier", "offset"}}};
+    for (const auto& [element, names] : numbers) {
+      const TiXmlElement* e = joint->FirstChildElement(element);
+      if (!e) continue;
+      for (const char* name : names) {
+        double v = 0;
+        if (e->Attribute(name) && !finiteAttribute(e, name, v))
+          throw UrdfError(where + element + "> " + name + " is not a finite number (" + quoted(e, name) + ")");
+      }
+    }
+  }
+}
+
 constexpr const char* kLoop = ": a kinematic loop; a manipulator's links must form a tree";
 
 // Checks in the XML that the joints link the links into one tree, before urdfdom builds it:
@@ -309,6 +341,7 @@ void checkDocument(const std::string& text, const std::string& fileName) {
   const TiXmlElement* robot = doc.FirstChildElement("robot");
   if (!robot) return;  // and a missing <robot>
   checkInertials(robot, fileName);
+  checkJointNumbers(robot, fileName);
   checkJointGraph(robot, fileName);
 }
 

@@ -564,6 +564,30 @@ TEST_F(UrdfInputTest, NonFiniteInertialsAreRefusedWithTheLinkName) {
   EXPECT_NEAR(loadUrdf(f)->getLink(0).mass, 2.0, 1e-12);
 }
 
+// Issue 20: a joint with a number that is not finite is refused naming the file and the joint
+// (urdfdom refused a <limit> of nan only as "not a valid URDF document").
+TEST_F(UrdfInputTest, NonFiniteJointNumbersAreRefusedWithTheJointName) {
+  auto arm = [&](const std::string& jointXml) {
+    return write("arm.urdf", "<robot name=\"arm\"><link name=\"base\"/><link name=\"upper\"/><joint name=\"shoulder\" "
+                             "type=\"revolute\"><parent link=\"base\"/><child link=\"upper\"/>" +
+                                 jointXml + "</joint></robot>");
+  };
+  std::string f = arm("<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"nan\" velocity=\"1\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <limit> effort is not a finite number ('nan')");
+  f = arm("<axis xyz=\"0 0 1\"/><limit lower=\"-inf\" upper=\"1\" effort=\"1\" velocity=\"1\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <limit> lower is not a finite number ('-inf')");
+  f = arm("<axis xyz=\"0 0 1\"/><dynamics damping=\"1e999\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <dynamics> damping is not a finite number ('1e999')");
+  f = arm("<axis xyz=\"0 nan 1\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <axis> xyz '0 nan 1' is not three finite numbers");
+  f = arm("<origin xyz=\"0 0 0.1\" rpy=\"0 inf 0\"/><axis xyz=\"0 0 1\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <origin> rpy '0 inf 0' is not three finite numbers");
+  f = arm("<axis xyz=\"0 0 1\"/><mimic joint=\"shoulder\" multiplier=\"nan\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <mimic> multiplier is not a finite number ('nan')");
+  f = arm("<axis xyz=\"0 -1 -4.37114e-08\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>");
+  EXPECT_EQ(message(f), "no error");
+}
+
 TEST_F(UrdfInputTest, SpecialDeepAndHugeFilesAreRefused) {
   EXPECT_EQ(message("/dev/zero"), "/dev/zero: cannot read the file: it is not a regular file");
   const std::string fifo = (dir_ / "arm.urdf").string();
