@@ -1,6 +1,7 @@
 // Kinematics and dynamics of the Puma 560 and the WAM 7, ours next to Orocos KDL's solvers
 // (ChainFkSolverPos_recursive, ChainJntToJacSolver, ChainIdSolver_RNE, ChainDynParam::JntToMass,
-// ChainFdSolver_RNE, ChainIkSolverPos_LMA), on the same 64 seeded random configurations.
+// ChainFdSolver_RNE, ChainIkSolverPos_LMA), on the same 64 seeded random configurations; and ours
+// on the same two arms loaded from URDF (Arg 16 and 17: the Placement form next to DH).
 #include <benchmark/benchmark.h>
 
 #include <kdl/chaindynparam.hpp>
@@ -12,6 +13,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <random>
@@ -64,7 +67,33 @@ Robot& wam7() {
   static Robot r(std::make_unique<WAM7Model>());
   return r;
 }
-Robot& robot(const benchmark::State& s) { return s.range(0) == 6 ? puma() : wam7(); }
+// The same arms written as URDF and loaded back (DHConvention::Placement: each joint's fixed
+// placement, then its motion), side by side with their DH models: Arg 16 and 17.
+std::unique_ptr<ManipulatorModel> throughUrdf(const ManipulatorModel& model) {
+  const std::string file = "/tmp/rp_model_bench_" + model.getName() + ".urdf";
+  std::ofstream(file) << toUrdf(model);
+  UrdfOptions options;
+  options.tip = "tool";
+  std::unique_ptr<ManipulatorModel> m = loadUrdf(file, options);
+  std::remove(file.c_str());
+  return m;
+}
+Robot& pumaUrdf() {
+  static Robot r(throughUrdf(Puma560Model()));
+  return r;
+}
+Robot& wam7Urdf() {
+  static Robot r(throughUrdf(WAM7Model()));
+  return r;
+}
+Robot& robot(const benchmark::State& s) {
+  switch (s.range(0)) {
+    case 6: return puma();
+    case 16: return pumaUrdf();
+    case 17: return wam7Urdf();
+    default: return wam7();
+  }
+}
 
 void ForwardKinematics_rp(benchmark::State& s) {
   Robot& r = robot(s);
@@ -169,7 +198,7 @@ void ForwardDynamicsArticulatedBody_rp(benchmark::State& s) {
     benchmark::DoNotOptimize(forwardDynamicsArticulatedBody(*r.model, *r.data, r.q[i], r.qd[i], r.qdd[i]).data());
   }
 }
-BENCHMARK(ForwardDynamicsArticulatedBody_rp)->Arg(6)->Arg(7);
+BENCHMARK(ForwardDynamicsArticulatedBody_rp)->Arg(6)->Arg(7)->Arg(16)->Arg(17);
 void ForwardDynamics_KDL(benchmark::State& s) {
   Robot& r = robot(s);
   KDL::ChainFdSolver_RNE fd(r.chain, KDL::Vector(0, 0, -9.81));
@@ -299,7 +328,7 @@ void Puma560ClosedFormIk_rp(benchmark::State& s) {
 BENCHMARK(Puma560ClosedFormIk_rp);
 
 #define RP_PAIR(name)                              \
-  BENCHMARK(name##_rp)->Arg(6)->Arg(7);            \
+  BENCHMARK(name##_rp)->Arg(6)->Arg(7)->Arg(16)->Arg(17); \
   BENCHMARK(name##_KDL)->Arg(6)->Arg(7)
 
 RP_PAIR(ForwardKinematics);

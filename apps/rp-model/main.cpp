@@ -5,6 +5,8 @@
 // COMMAND: fk | jacobian | gravity | rnea --qd .. --qdd .. | inertia | fd --qd .. --tau .. |
 //          ik --pose p1,...,p16 [--seed ..] | urdf | mjcf
 // Options: --motor-inertia and --friction add those effects to inertia, rnea and fd.
+// Joint values (--q, --qd, --qdd, --tau, --seed): "v1,v2,..." in joint order, or "name=value,..."
+// naming every joint once. Every result also lists the model's "joints" and "links" by name.
 // Units: SI and radians. Matrices are JSON arrays of rows. Bad input: one line on stderr, exit 2
 // (values that are not finite numbers, a --pose that is not a rigid transform).
 #include <nlohmann/json.hpp>
@@ -48,18 +50,48 @@ std::vector<double> numbers(const std::string& option, const std::string& text) 
   return v;
 }
 
-JointVector jointsOf(const std::map<std::string, std::string>& opts, const std::string& name, int n, bool required) {
+// One value per joint: "v1,v2,..." in joint order, or "name=value,..." naming every joint once.
+JointVector jointsOf(const ManipulatorModel& model, const std::map<std::string, std::string>& opts,
+                     const std::string& name, bool required) {
+  const int n = model.getNumberOfJoints();
   const auto it = opts.find(name);
   if (it == opts.end()) {
-    if (required) throw UsageError("missing " + name + " (" + std::to_string(n) + " comma-separated values)");
+    if (required) throw UsageError("missing " + name + " (" + std::to_string(n) + " comma-separated values, or name=value pairs)");
     return JointVector(n);
+  }
+  JointVector q(n);
+  if (it->second.find('=') != std::string::npos) {
+    std::vector<bool> given(static_cast<std::size_t>(n), false);
+    std::stringstream ss(it->second);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+      const std::size_t eq = item.find('=');
+      if (eq == std::string::npos) throw UsageError(name + ": '" + item + "' is not a name=value pair (give all values by name or none)");
+      const std::string joint = item.substr(0, eq);
+      const int i = model.findJoint(joint);
+      if (i < 0) {
+        std::string names;
+        for (int k = 0; k < n; ++k) {
+          if (k > 0) names += ", ";
+          names += model.getJointName(k);
+        }
+        throw UsageError(name + ": the robot has no joint '" + joint + "' (joints: " + names + ")");
+      }
+      if (given[static_cast<std::size_t>(i)]) throw UsageError(name + ": joint '" + joint + "' is given twice");
+      given[static_cast<std::size_t>(i)] = true;
+      const std::vector<double> v = numbers(name, item.substr(eq + 1));
+      if (v.size() != 1) throw UsageError(name + ": '" + item + "' is not a name=value pair");
+      q(i) = v[0];
+    }
+    for (int i = 0; i < n; ++i)
+      if (!given[static_cast<std::size_t>(i)]) throw UsageError(name + ": no value for joint '" + model.getJointName(i) + "'");
+    return q;
   }
   const std::vector<double> v = numbers(name, it->second);
   if (static_cast<int>(v.size()) != n) {
     throw UsageError(name + " has " + std::to_string(v.size()) + " values; the robot has " + std::to_string(n) +
                      " joints");
   }
-  JointVector q(n);
   for (int i = 0; i < n; ++i) q(i) = v[static_cast<std::size_t>(i)];
   return q;
 }
@@ -88,7 +120,7 @@ int run(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
-      std::cout << "usage: rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] COMMAND --q v1,v2,... [--qd ..] [--qdd ..] [--tau ..]\n"
+      std::cout << "usage: rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] COMMAND --q v1,v2,...|name=value,... [--qd ..] [--qdd ..] [--tau ..]\n"
                    "                [--pose p1,...,p16] [--seed ..] [--motor-inertia] [--friction]\n"
                    "COMMAND: fk jacobian gravity rnea inertia fd ik urdf mjcf\n";
       return 0;
@@ -116,7 +148,10 @@ int run(int argc, char** argv) {
     if (opts.count("--tip")) urdf.tip = opts.at("--tip");
     urdf.requireDynamics =
         command == "gravity" || command == "rnea" || command == "inertia" || command == "fd" || command == "mjcf";
+    std::vector<std::string> notes;
+    urdf.notes = &notes;
     model = loadUrdf(robot, urdf);
+    for (const std::string& note : notes) std::cerr << "rp-model: note: " << note << std::endl;
   } else {
     throw UsageError("unknown robot '" + robot + "' (known: puma560, wam4, wam7, or a .urdf file)");
   }
@@ -156,7 +191,7 @@ int run(int argc, char** argv) {
       for (const Puma560IkSolution& s : all)
         solutions.push_back({{"q", vector(s.q)}, {"branch", s.branchName()}, {"withinLimits", s.withinLimits}});
     } else {
-      const JointVector seed = opts.count("--seed") ? jointsOf(opts, "--seed", n, true) : model->getHomePosition();
+      const JointVector seed = opts.count("--seed") ? jointsOf(*model, opts, "--seed", true) : model->getHomePosition();
       JointVector q(n);
       if (inverseKinematics(*model, data, T, seed, q) != IkStatus::Solved)
         throw UsageError("no solution found within the joint limits (unreachable pose?)");
@@ -164,7 +199,7 @@ int run(int argc, char** argv) {
     }
     out["solutions"] = solutions;
   } else {
-    const JointVector q = jointsOf(opts, "--q", n, true);
+    const JointVector q = jointsOf(*model, opts, "--q", true);
     if (command == "fk") {
       out["fk"] = matrix(forwardKinematics(*model, data, q));
     } else if (command == "jacobian") {
@@ -174,18 +209,25 @@ int run(int argc, char** argv) {
       gravityTorque(*model, data, q, g);
       out["tau"] = vector(g);
     } else if (command == "rnea") {
-      out["tau"] = vector(inverseDynamics(*model, data, q, jointsOf(opts, "--qd", n, true),
-                                          jointsOf(opts, "--qdd", n, true), dyn));
+      out["tau"] = vector(inverseDynamics(*model, data, q, jointsOf(*model, opts, "--qd", true),
+                                          jointsOf(*model, opts, "--qdd", true), dyn));
     } else if (command == "inertia") {
       out["M"] = matrix(massMatrix(*model, data, q, dyn.motorInertia));
     } else if (command == "fd") {
-      out["qdd"] = vector(forwardDynamics(*model, data, q, jointsOf(opts, "--qd", n, true),
-                                          jointsOf(opts, "--tau", n, true), dyn));
+      out["qdd"] = vector(forwardDynamics(*model, data, q, jointsOf(*model, opts, "--qd", true),
+                                          jointsOf(*model, opts, "--tau", true), dyn));
     } else {
       throw UsageError(command.empty() ? "missing COMMAND (fk jacobian gravity rnea inertia fd ik urdf mjcf)"
                                        : "unknown command '" + command + "' (fk jacobian gravity rnea inertia fd ik urdf mjcf)");
     }
   }
+  json joints = json::array(), links = json::array();
+  for (int i = 0; i < n; ++i) {
+    joints.push_back(model->getJointName(i));
+    links.push_back(model->getLinkName(i));
+  }
+  out["joints"] = joints;
+  out["links"] = links;
   std::cout << out.dump() << std::endl;
   return 0;
 }

@@ -55,7 +55,7 @@ std::string resolveMesh(const std::string& name, const std::filesystem::path& ur
 }  // namespace
 
 std::vector<Shape> loadUrdfVisuals(const std::string& urdfFile, const std::string& tip) {
-  // The model (and the checks) of loadUrdf(): the DH frames the shapes are attached to.
+  // The model (and the checks) of loadUrdf(): the link frames the shapes are attached to.
   UrdfOptions options;
   options.tip = tip;
   const std::unique_ptr<ManipulatorModel> model = loadUrdf(urdfFile, options);
@@ -66,30 +66,14 @@ std::vector<Shape> loadUrdfVisuals(const std::string& urdfFile, const std::strin
   const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text.str());
   if (!robot || !robot->getRoot()) throw UrdfError(urdfFile + ": not a valid URDF file");
 
-  // The movable joints of the chain root -> tip, in order (the tip as loadUrdf chooses it: the
-  // model has as many joints as the chain has movable joints, so the chain is found from the tip
-  // or, without one, by following the unbranched chain to its last movable joint).
-  urdf::LinkConstSharedPtr tipLink;
-  if (!tip.empty()) {
-    tipLink = robot->getLink(tip);
-  } else {
-    urdf::LinkConstSharedPtr link = robot->getRoot(), lastMovable;
-    while (link->child_joints.size() == 1) {
-      const urdf::JointConstSharedPtr j = link->child_joints.front();
-      link = robot->getLink(j->child_link_name);
-      if (isMovable(j)) lastMovable = link;
-    }
-    tipLink = lastMovable ? lastMovable : link;
-  }
-  std::vector<std::string> chain;  // names of the movable joints, root first
-  for (urdf::LinkConstSharedPtr link = tipLink; link && link->parent_joint;
-       link = robot->getLink(link->parent_joint->parent_link_name))
-    if (isMovable(link->parent_joint)) chain.insert(chain.begin(), link->parent_joint->name);
+  // The movable joints of the chain root -> tip, in order: the model's own joints (loadUrdf()
+  // chose the tip and kept the URDF's joint names).
+  std::vector<std::string> chain;
+  for (int i = 0; i < model->getNumberOfJoints(); ++i) chain.push_back(model->getJointName(i));
   const int n = model->getNumberOfJoints();
-  if (static_cast<int>(chain.size()) != n) throw UrdfError(urdfFile + ": the chain to the tip does not match the model");
 
-  // DH frames at q = 0 in the URDF root frame (the model's base is DH frame 0 in the root frame;
-  // joint values keep the URDF's zero, so URDF link poses at q = 0 compare directly).
+  // Model link frames at q = 0 in the URDF root frame (the model's base is the root frame; joint
+  // values keep the URDF's zero, so URDF link poses at q = 0 compare directly).
   ManipulatorData data(*model);
   forwardKinematics(*model, data, JointVector::Zero(n));
   auto frameAtZero = [&](int k) -> Transform {

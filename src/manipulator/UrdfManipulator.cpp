@@ -2,6 +2,7 @@
 #include "rp/manipulator/UrdfManipulator.hpp"
 
 #include <filesystem>
+#include <iostream>
 #include <stdexcept>
 #include <tuple>
 #include <utility>
@@ -32,12 +33,15 @@ std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, const std::st
   UrdfOptions options;
   options.tip = tip;
   options.requireDynamics = true;
+  std::vector<std::string> notes;
+  options.notes = &notes;
   std::unique_ptr<ManipulatorModel> m = loadUrdf(file, options);
+  for (const std::string& note : notes) std::cerr << "rp: UrdfManipulator '" << name << "': " << note << std::endl;
   // Place the arm where the object stands: the object's pose times the URDF's own base frame.
   std::vector<LinkParameters> links;
   for (int i = 0; i < m->getNumberOfJoints(); ++i) links.push_back(m->getLink(i));
   return std::make_unique<ManipulatorModel>(m->getName(), links, Transform(base * m->getBaseTransform()),
-                                            m->getToolTransform());
+                                            m->getToolTransform(), m->getGravity(), m->getConvention());
 }
 }  // namespace
 

@@ -1,6 +1,6 @@
 #pragma once
 // Link transforms and joint axes shared by the kinematics, dynamics and IK algorithms, for both
-// DH conventions and both joint types (private to src/model).
+// DH conventions, the Placement form and both joint types (private to src/model).
 #include <cmath>
 
 #include "rp/model/ManipulatorData.hpp"
@@ -11,27 +11,36 @@ namespace rp::internal {
 inline void linkMatrix(const ManipulatorModel& model, int i, double qi, Eigen::Matrix<double, 3, 4>& A) {
   const LinkParameters& l = model.getLink(i);
   const bool prismatic = l.type == JointType::Prismatic;
-  const double theta = prismatic ? l.offset : qi + l.offset;
-  const double d = prismatic ? l.d + qi : l.d;
-  const double ct = std::cos(theta), st = std::sin(theta);
-  const double ca = model.getCosAlpha()(i), sa = model.getSinAlpha()(i);
   if (model.getConvention() == DHConvention::Standard) {
+    const double theta = prismatic ? l.offset : qi + l.offset;
+    const double d = prismatic ? l.d + qi : l.d;
+    const double ct = std::cos(theta), st = std::sin(theta);
+    const double ca = model.getCosAlpha()(i), sa = model.getSinAlpha()(i);
     // Rz(theta) Tz(d) Tx(a) Rx(alpha)
     A << ct, -st * ca, st * sa, l.a * ct,  //
         st, ct * ca, -ct * sa, l.a * st,   //
         0, sa, ca, d;
   } else {
-    // Rx(alpha) Tx(a) Rz(theta) Tz(d)
-    A << ct, -st, 0, l.a,              //
-        ca * st, ca * ct, -sa, -sa * d,  //
-        sa * st, sa * ct, ca, ca * d;
+    // Modified DH and Placement: P_i Rz(q) or P_i Tz(q), with P_i the fixed part (for modified DH
+    // Rx(alpha) Tx(a) Rz(offset) Tz(d), precomputed by the model).
+    const Transform& P = model.getPlacement(i);
+    if (prismatic) {
+      A = P.topRows<3>();
+      A.col(3) += qi * P.block<3, 1>(0, 2);
+    } else {
+      const double c = std::cos(qi), s = std::sin(qi);
+      A.col(0) = c * P.block<3, 1>(0, 0) + s * P.block<3, 1>(0, 1);
+      A.col(1) = c * P.block<3, 1>(0, 1) - s * P.block<3, 1>(0, 0);
+      A.rightCols<2>() = P.block<3, 2>(0, 2);
+    }
   }
 }
 
 // The world frame whose z axis is joint j's axis and whose origin lies on that axis, from the last
-// forward kinematics: frame j-1 (the base for j = 0) in standard DH, frame j in modified DH.
+// forward kinematics: frame j-1 (the base for j = 0) in standard DH, frame j in modified DH and
+// the Placement form.
 inline const Transform& axisFrame(const ManipulatorModel& model, const ManipulatorData& data, int j) {
-  if (model.getConvention() == DHConvention::Modified) return data.linkTransforms[static_cast<std::size_t>(j)];
+  if (model.getConvention() != DHConvention::Standard) return data.linkTransforms[static_cast<std::size_t>(j)];
   return j == 0 ? model.getBaseTransform() : data.linkTransforms[static_cast<std::size_t>(j - 1)];
 }
 

@@ -1,5 +1,6 @@
-// Recursive Newton-Euler dynamics for serial chains in standard or modified DH, with revolute and
-// prismatic joints (rp/model/Dynamics.hpp).
+// Recursive Newton-Euler dynamics for serial chains in standard or modified DH or the Placement
+// form (which takes the modified-DH path: joint i moves about z_i through frame i's origin), with
+// revolute and prismatic joints (rp/model/Dynamics.hpp).
 //
 // Link quantities live in link coordinates, as in Luh, Walker and Paul's formulation and the
 // Robotics Toolbox's rne_dh / rne_mdh: R_i and p_i are the rotation and origin of frame i in frame

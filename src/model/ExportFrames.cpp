@@ -10,11 +10,11 @@ namespace rp::internal {
 
 JointFrames jointFrames(const ManipulatorModel& model, int k) {
   const LinkParameters& l = model.getLink(k);
-  const Transform fixed = zRotation(l.offset) * translation(0, 0, l.d);
   if (model.getConvention() == DHConvention::Standard) {
-    return {fixed, Transform(translation(l.a, 0, 0) * xRotation(l.alpha))};
+    return {Transform(zRotation(l.offset) * translation(0, 0, l.d)), Transform(translation(l.a, 0, 0) * xRotation(l.alpha))};
   }
-  return {Transform(xRotation(l.alpha) * translation(l.a, 0, 0) * fixed), Transform::unit()};
+  // Modified DH and Placement: the fixed part precedes the motion (getPlacement()).
+  return {model.getPlacement(k), Transform::unit()};
 }
 
 JointFriction jointFriction(const LinkParameters& l) {

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -42,39 +43,57 @@ Transform toTransform(const urdf::Pose& p) {
   return t;
 }
 
-// A rigid body accumulated in root coordinates (at q = 0).
+// The inertial parts of one model link (its URDF link and what is fixed to it), in the link's
+// model frame.
 struct Body {
-  double mass = 0;
-  V3 moment = V3::Zero();           // sum of m c
-  Eigen::Matrix3d inertiaAtOrigin;  // sum of I_c + m (|c|^2 1 - c c^T), about the root origin
-  bool any = false;
-  Body() { inertiaAtOrigin.setZero(); }
-  void add(double m, const V3& c, const Eigen::Matrix3d& Ic) {
-    mass += m;
-    moment += m * c;
-    inertiaAtOrigin += Ic + m * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
-    any = true;
+  struct Part {
+    double mass;
+    V3 com;
+    Eigen::Matrix3d inertia;  // about the part's centre of mass
+  };
+  std::vector<Part> parts;
+  void add(double m, const V3& c, const Eigen::Matrix3d& Ic) { parts.push_back({m, c, Ic}); }
+  // The whole: mass, centre of mass and inertia about it (parallel axes about the common centre,
+  // so a single part comes out exactly as given). A massless body (which may still have
+  // rotational inertia, like the Puma's link 1) has its centre at the frame origin.
+  void combine(double& mass, Vector<3>& com, Matrix<3, 3>& inertia) const {
+    double m = 0;
+    V3 moment = V3::Zero();
+    for (const Part& p : parts) {
+      m += p.mass;
+      moment += p.mass * p.com;
+    }
+    const V3 c = parts.size() == 1 ? parts[0].com : m > 0 ? V3(moment / m) : V3::Zero();
+    Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
+    for (const Part& p : parts) {
+      const V3 r = p.com - c;
+      I += p.inertia;
+      if (p.mass != 0) I += p.mass * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+    }
+    mass = m;
+    com = Vector<3>(c);
+    inertia = Matrix<3, 3>(I);
   }
 };
 
-struct Line {
-  V3 point, direction;
+// One movable joint of the chain and the link it moves.
+struct ChainLink {
+  urdf::JointConstSharedPtr joint;
+  Transform placement;  // P_i of DHConvention::Placement
+  Body body;
 };
 
-// The DH frame whose z is `axis` and whose origin lies on it, with x along the common normal
-// from the previous frame's z axis (or a free perpendicular).
-Transform frame(const V3& origin, const V3& z, const V3& x) {
-  Transform f = Transform::unit();
-  f.block<3, 1>(0, 0) = x;
-  f.block<3, 1>(0, 1) = z.cross(x);
-  f.block<3, 1>(0, 2) = z;
-  f.topRightCorner<3, 1>() = origin;
-  return f;
-}
-
-V3 anyPerpendicular(const V3& z) {
+// The rotation whose z axis is the unit vector `z` (x completed from a coordinate axis): the unit
+// matrix for z itself and exact signed permutations for the other coordinate axes, so that
+// axis-aligned joints add no rounding at all.
+Eigen::Matrix3d axisRotation(const V3& z) {
   const V3 trial = std::abs(z.x()) < 0.9 ? V3::UnitX() : V3::UnitY();
-  return (trial - trial.dot(z) * z).normalized();
+  const V3 x = (trial - trial.dot(z) * z).normalized();
+  Eigen::Matrix3d R;
+  R.col(0) = x;
+  R.col(1) = z.cross(x);
+  R.col(2) = z;
+  return R;
 }
 
 // At most this much of a name is quoted in a message.
@@ -225,6 +244,38 @@ void checkInertials(const TiXmlElement* robot, const std::string& fileName) {
   }
 }
 
+// Checks the numbers of every joint in the XML itself: urdfdom refuses a joint whose <limit> holds
+// `nan` with "not a valid URDF document", naming neither the joint nor the value.
+void checkJointNumbers(const TiXmlElement* robot, const std::string& fileName) {
+  for (const TiXmlElement* joint = robot->FirstChildElement("joint"); joint; joint = joint->NextSiblingElement("joint")) {
+    const char* nameAttribute = joint->Attribute("name");
+    const std::string where = fileName + ": joint '" + excerpt(nameAttribute ? nameAttribute : "") + "': <";
+    auto quoted = [](const TiXmlElement* e, const char* name) {
+      std::string q(1, '\'');  // appended piece by piece: GCC 12 warns (-Wrestrict) about "'" + s
+      q += excerpt(e->Attribute(name));
+      q += '\'';
+      return q;
+    };
+    for (const char* element : {"origin", "axis"}) {
+      const TiXmlElement* e = joint->FirstChildElement(element);
+      for (const char* name : {"xyz", "rpy"})
+        if (e && !finiteTriple(e, name))
+          throw UrdfError(where + element + "> " + name + " " + quoted(e, name) + " is not three finite numbers");
+    }
+    const std::pair<const char*, std::vector<const char*>> numbers[] = {
+        {"limit", {"lower", "upper", "effort", "velocity"}}, {"dynamics", {"damping", "friction"}}, {"mimic", {"multiplier", "offset"}}};
+    for (const auto& [element, names] : numbers) {
+      const TiXmlElement* e = joint->FirstChildElement(element);
+      if (!e) continue;
+      for (const char* name : names) {
+        double v = 0;
+        if (e->Attribute(name) && !finiteAttribute(e, name, v))
+          throw UrdfError(where + element + "> " + name + " is not a finite number (" + quoted(e, name) + ")");
+      }
+    }
+  }
+}
+
 constexpr const char* kLoop = ": a kinematic loop; a manipulator's links must form a tree";
 
 // Checks in the XML that the joints link the links into one tree, before urdfdom builds it:
@@ -290,6 +341,7 @@ void checkDocument(const std::string& text, const std::string& fileName) {
   const TiXmlElement* robot = doc.FirstChildElement("robot");
   if (!robot) return;  // and a missing <robot>
   checkInertials(robot, fileName);
+  checkJointNumbers(robot, fileName);
   checkJointGraph(robot, fileName);
 }
 
@@ -325,6 +377,148 @@ bool finite(const urdf::Pose& p) {
          std::isfinite(p.rotation.w);
 }
 
+// The URDF's own forward kinematics of the chain: the product of each joint's origin and its
+// motion about (or along) its axis.
+Transform walkChain(const std::vector<urdf::JointConstSharedPtr>& chain, const JointVector& q) {
+  Transform T = Transform::unit();
+  int k = 0;
+  for (const urdf::JointConstSharedPtr& j : chain) {
+    T = Transform(T * toTransform(j->parent_to_joint_origin_transform));
+    if (j->type == urdf::Joint::FIXED) continue;
+    const V3 axis = V3(j->axis.x, j->axis.y, j->axis.z).normalized();
+    Transform M = Transform::unit();
+    if (j->type == urdf::Joint::PRISMATIC) M.topRightCorner<3, 1>() = q(k) * axis;
+    else M.topLeftCorner<3, 3>() = Eigen::AngleAxisd(q(k), axis).toRotationMatrix();
+    T = Transform(T * M);
+    ++k;
+  }
+  return T;
+}
+
+// Self-check: the model's forward kinematics must reproduce the description's at the zero
+// configuration and at a few spread over the joint ranges (a deterministic sequence, the same for
+// every load).
+void selfCheck(const ManipulatorModel& model, const std::vector<urdf::JointConstSharedPtr>& chain,
+               const std::string& fileName) {
+  const int n = model.getNumberOfJoints();
+  ManipulatorData data(model);
+  JointVector q(n);
+  for (int trial = 0; trial < 5; ++trial) {
+    for (int i = 0; i < n; ++i) {
+      const double lo = model.getPositionMin()(i), hi = model.getPositionMax()(i);
+      const double fraction = trial == 0 ? -1 : std::fmod(0.6180339887498949 * (i + 1) * (trial + 2) + 0.1 * trial, 1.0);
+      q(i) = trial == 0 ? std::clamp(0.0, lo, hi) : lo + fraction * (hi - lo);
+    }
+    const Transform expected = walkChain(chain, q);
+    const Transform& T = forwardKinematics(model, data, q);
+    const double scale = 1 + expected.topRightCorner<3, 1>().cwiseAbs().maxCoeff();
+    if (!T.allFinite() || !((T - expected).cwiseAbs().maxCoeff() <= 1e-9 * scale)) {
+      std::string at;
+      for (int i = 0; i < n; ++i) {
+        if (i > 0) at += ',';
+        at += std::to_string(q(i));
+      }
+      throw UrdfError(fileName + ": internal error: the model's forward kinematics differs from the description's at q = (" +
+                      at + ")");
+    }
+  }
+}
+
+bool isMovable(const urdf::Joint& j) {
+  return j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS || j.type == urdf::Joint::PRISMATIC;
+}
+
+// Whether a name suggests a gripper's joint or link.
+bool looksLikeGripper(std::string name) {
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* word : {"grip", "finger", "jaw", "claw"})
+    if (name.find(word) != std::string::npos) return true;
+  return false;
+}
+
+bool isGripperJoint(const urdf::Joint& j) { return looksLikeGripper(j.name) || looksLikeGripper(j.child_link_name); }
+
+// The default tip: from the root, follow the one child joint whose subtree moves (a branch that
+// carries only fixed frames, such as tool0 or a camera, is no branch) to the last moving link.
+// Where everything that moves further on is a gripper (joints or links named grip..., finger,
+// jaw, claw), the arm ends there and the gripper is lumped (see loadUrdf()). Two or more other
+// moving subtrees are a real choice: refused, listing the leaf links below as candidate tips.
+urdf::LinkConstSharedPtr defaultTip(const urdf::ModelInterface& robot, const urdf::LinkConstSharedPtr& root,
+                                    const std::string& fileName) {
+  // Links with a movable joint somewhere below them, and with one that is not a gripper's, marked
+  // upwards from each movable joint (each link is marked once).
+  std::unordered_set<const urdf::Link*> movesBelow, armBelow;
+  auto markUp = [&](const urdf::Joint& joint, std::unordered_set<const urdf::Link*>& marks) {
+    for (urdf::LinkConstSharedPtr link = robot.getLink(joint.parent_link_name); link && marks.insert(link.get()).second;
+         link = link->parent_joint ? robot.getLink(link->parent_joint->parent_link_name) : nullptr) {
+    }
+  };
+  // (Floating and planar joints count as moving, so that a chain through one is refused by name.)
+  auto moving = [](const urdf::Joint& j) { return j.type != urdf::Joint::FIXED; };
+  for (const auto& [name, joint] : robot.joints_) {
+    if (!joint || !moving(*joint)) continue;
+    markUp(*joint, movesBelow);
+    if (!isGripperJoint(*joint)) markUp(*joint, armBelow);
+  }
+  auto below = [&](const urdf::JointConstSharedPtr& j, const std::unordered_set<const urdf::Link*>& marks) {
+    const urdf::LinkConstSharedPtr child = robot.getLink(j->child_link_name);
+    return child && marks.count(child.get()) > 0;
+  };
+  urdf::LinkConstSharedPtr link = root, lastMoving;
+  for (;;) {
+    std::vector<urdf::JointConstSharedPtr> branches;
+    bool arm = false;  // something that is not a gripper moves further on
+    for (const urdf::JointSharedPtr& c : link->child_joints) {
+      if (!c || !(moving(*c) || below(c, movesBelow))) continue;
+      branches.push_back(c);
+      arm = arm || (moving(*c) && !isGripperJoint(*c)) || below(c, armBelow);
+    }
+    if (branches.empty() || !arm) break;
+    if (branches.size() > 1) {
+      std::vector<std::string> leaves;
+      std::vector<urdf::LinkConstSharedPtr> todo{link};
+      while (!todo.empty()) {
+        const urdf::LinkConstSharedPtr l = todo.back();
+        todo.pop_back();
+        if (l->child_joints.empty()) leaves.push_back(l->name);
+        for (const urdf::JointSharedPtr& c : l->child_joints)
+          if (c) todo.push_back(robot.getLink(c->child_link_name));
+      }
+      std::sort(leaves.begin(), leaves.end());
+      std::string list;
+      for (std::size_t i = 0; i < leaves.size() && i < 12; ++i) {
+        if (i > 0) list += ", ";
+        list += '\'';  // piece by piece: GCC 12 warns (-Wrestrict) about "'" + s
+        list += excerpt(leaves[i]);
+        list += '\'';
+      }
+      if (leaves.size() > 12) list += ", ...";
+      throw UrdfError(fileName + ": the robot branches at link '" + excerpt(link->name) + "' into " +
+                      std::to_string(branches.size()) + " moving chains; name the tip link, one of " + list);
+    }
+    const urdf::JointConstSharedPtr j = branches.front();
+    link = robot.getLink(j->child_link_name);
+    if (moving(*j)) lastMoving = link;
+  }
+  return lastMoving ? lastMoving : link;
+}
+
+// Every mimic joint names an existing joint other than itself, with a finite multiplier and
+// offset, and mimics do not go round in a circle.
+void checkMimics(const urdf::ModelInterface& robot, const std::string& fileName) {
+  for (const auto& [name, joint] : robot.joints_) {
+    if (!joint || !joint->mimic) continue;
+    const std::string where = fileName + ": joint '" + excerpt(name) + "' mimics ";
+    const urdf::JointMimic& m = *joint->mimic;
+    if (!robot.getJoint(m.joint_name)) throw UrdfError(where + "joint '" + excerpt(m.joint_name) + "', which does not exist");
+    if (!std::isfinite(m.multiplier) || !std::isfinite(m.offset))
+      throw UrdfError(where + "'" + excerpt(m.joint_name) + "' with a multiplier or offset that is not finite");
+    std::unordered_set<std::string> seen{name};
+    for (urdf::JointConstSharedPtr j = robot.getJoint(m.joint_name); j && j->mimic; j = robot.getJoint(j->mimic->joint_name))
+      if (!seen.insert(j->name).second) throw UrdfError(where + "'" + excerpt(m.joint_name) + "': the mimic joints go round in a circle");
+  }
+}
+
 // urdfdom links children with shared pointers: a long chain would be freed by one recursive
 // destructor call per link (a stack overflow for 100,000 links) and a loop would never be freed.
 // Dropping those pointers first leaves each link to be freed alone by the model's own maps.
@@ -348,6 +542,7 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
   const urdf::LinkConstSharedPtr root = robot->getRoot();
   if (!root) throw UrdfError(fileName + ": the robot has no root link");
   checkTree(*robot, *root, fileName);
+  checkMimics(*robot, fileName);
 
   // The chain of joints from the root to the tip.
   urdf::LinkConstSharedPtr tip;
@@ -355,18 +550,7 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     tip = robot->getLink(options.tip);
     if (!tip) throw UrdfError(fileName + ": there is no link '" + options.tip + "'");
   } else {
-    urdf::LinkConstSharedPtr link = root, lastMovable;
-    while (!link->child_joints.empty()) {
-      if (link->child_joints.size() > 1) {
-        throw UrdfError(fileName + ": the robot branches at link '" + link->name + "'; name the tip link");
-      }
-      const urdf::JointConstSharedPtr j = link->child_joints.front();
-      link = robot->getLink(j->child_link_name);
-      if (j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::CONTINUOUS || j->type == urdf::Joint::PRISMATIC) {
-        lastMovable = link;
-      }
-    }
-    tip = lastMovable ? lastMovable : link;
+    tip = defaultTip(*robot, root, fileName);
   }
   std::vector<urdf::JointConstSharedPtr> chain;
   for (urdf::LinkConstSharedPtr link = tip; link->parent_joint; link = robot->getLink(link->parent_joint->parent_link_name)) {
@@ -374,130 +558,152 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
   }
   std::reverse(chain.begin(), chain.end());
 
-  // Poses at q = 0 in root coordinates; movable joints' lines; bodies per movable joint.
-  std::vector<Line> axes;
-  std::vector<urdf::JointConstSharedPtr> movable;
-  std::vector<Body> bodies;
-  Transform linkPose = Transform::unit();
+  // The chain as the file says it (the Placement form): link frame i is the child link of movable
+  // joint i turned by axisRotation() so that its z axis is the joint's axis, and P_i places that
+  // frame (at q_i = 0) in link frame i-1. `C` is the pose, at q = 0, of the URDF link being
+  // walked in the current model frame (the root frame before the first joint).
+  std::vector<ChainLink> links;
+  Transform C = Transform::unit();
   std::unordered_set<std::string> chainLinks;
   for (const urdf::JointConstSharedPtr& j : chain) chainLinks.insert(j->child_link_name);
-  // A link's inertia and that of everything fixed to it off the chain (e.g. a camera), walked
-  // with an explicit stack: a chain of many fixed links must not recurse once per link.
-  std::vector<std::pair<urdf::LinkConstSharedPtr, Transform>> pending;
+  // The value at which a moving joint off the chain is lumped: the user's, its master's for a
+  // mimic joint (multiplier and offset), or zero within its limits.
+  auto offChainValue = [&](const urdf::Joint& joint) {
+    const urdf::Joint* j = &joint;
+    double multiplier = 1, offset = 0;
+    for (std::size_t depth = 0; depth <= robot->joints_.size(); ++depth) {
+      if (const auto it = options.offChainPositions.find(j->name); it != options.offChainPositions.end())
+        return multiplier * it->second + offset;
+      if (!j->mimic) break;
+      offset += multiplier * j->mimic->offset;
+      multiplier *= j->mimic->multiplier;
+      j = robot->getJoint(j->mimic->joint_name).get();
+    }
+    double v = 0;
+    if (j->limits && j->type != urdf::Joint::CONTINUOUS) v = std::clamp(0.0, j->limits->lower, j->limits->upper);
+    return multiplier * v + offset;
+  };
+  for (const auto& [name, value] : options.offChainPositions) {
+    if (!robot->getJoint(name)) throw UrdfError(fileName + ": UrdfOptions::offChainPositions: there is no joint '" + excerpt(name) + "'");
+    if (!std::isfinite(value))
+      throw UrdfError(fileName + ": UrdfOptions::offChainPositions: joint '" + excerpt(name) + "': the value is not finite");
+  }
+  // A link's inertia and that of everything hanging on it off the chain: fixed (a camera) or
+  // moving (fingers, a jaw: at offChainValue(), reported in a note), walked with an explicit
+  // stack: a chain of many fixed links must not recurse once per link.
+  struct Pending {
+    urdf::LinkConstSharedPtr link;
+    Transform pose;
+    bool moved;  // below a moving joint off the chain
+  };
+  std::vector<Pending> pending;
   auto addInertial = [&](const urdf::LinkConstSharedPtr& start, const Transform& startPose) {
-    if (bodies.empty()) return;  // links before the first joint belong to the base
+    if (links.empty()) return;  // links before the first joint belong to the base
+    std::string movedLinks, movingJoints;
     pending.clear();
-    pending.emplace_back(start, startPose);
+    pending.push_back({start, startPose, false});
     while (!pending.empty()) {
-      const urdf::LinkConstSharedPtr link = pending.back().first;
-      const Transform pose = pending.back().second;
+      const Pending p = pending.back();
       pending.pop_back();
-      if (link->inertial) {
-        const Transform in = Transform(pose * toTransform(link->inertial->origin));
+      if (p.link->inertial) {
+        const Transform in = Transform(p.pose * toTransform(p.link->inertial->origin));
         const Eigen::Matrix3d R = in.topLeftCorner<3, 3>();
         Eigen::Matrix3d I;
-        const urdf::Inertial& i = *link->inertial;
+        const urdf::Inertial& i = *p.link->inertial;
         I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
-        bodies.back().add(i.mass, in.topRightCorner<3, 1>(), R * I * R.transpose());
+        links.back().body.add(i.mass, in.topRightCorner<3, 1>(), R * I * R.transpose());
       }
-      for (const urdf::JointSharedPtr& c : link->child_joints) {
-        if (c->type != urdf::Joint::FIXED) continue;
+      for (const urdf::JointSharedPtr& c : p.link->child_joints) {
         if (chainLinks.count(c->child_link_name)) continue;
-        pending.emplace_back(robot->getLink(c->child_link_name),
-                             Transform(pose * toTransform(c->parent_to_joint_origin_transform)));
+        if (c->type != urdf::Joint::FIXED && !isMovable(*c)) continue;  // a floating or planar body is not carried
+        if (!finite(c->parent_to_joint_origin_transform))
+          throw UrdfError(fileName + ": joint '" + excerpt(c->name) + "' has an origin that is not finite");
+        Transform child = Transform(p.pose * toTransform(c->parent_to_joint_origin_transform));
+        if (isMovable(*c)) {
+          const V3 axis = V3(c->axis.x, c->axis.y, c->axis.z);
+          if (!axis.allFinite() || axis.norm() < 1e-12)
+            throw UrdfError(fileName + ": joint '" + excerpt(c->name) + "' has an axis that is zero or not finite");
+          const double v = offChainValue(*c);
+          Transform motion = Transform::unit();
+          if (c->type == urdf::Joint::PRISMATIC) motion.topRightCorner<3, 1>() = v * axis.normalized();
+          else motion.topLeftCorner<3, 3>() = Eigen::AngleAxisd(v, axis.normalized()).toRotationMatrix();
+          child = Transform(child * motion);
+          char value[64];
+          std::snprintf(value, sizeof value, " = %g", v);
+          if (!movingJoints.empty()) movingJoints += ", ";
+          movingJoints += excerpt(c->name);
+          movingJoints += value;
+        }
+        const bool moved = p.moved || isMovable(*c);
+        if (moved) {
+          if (!movedLinks.empty()) movedLinks += ", ";
+          movedLinks += '\'';  // piece by piece: GCC 12 warns (-Wrestrict) about "'" + s
+          movedLinks += excerpt(c->child_link_name);
+          movedLinks += '\'';
+        }
+        pending.push_back({robot->getLink(c->child_link_name), child, moved});
       }
+    }
+    if (!movedLinks.empty() && options.notes) {
+      options.notes->push_back(fileName + ": links " + movedLinks + " move off the chain: their mass is lumped into '" +
+                               excerpt(links.back().joint->child_link_name) + "' at " + movingJoints +
+                               " (UrdfOptions::offChainPositions sets other values)");
     }
   };
   for (const urdf::JointConstSharedPtr& j : chain) {
-    if (!finite(j->parent_to_joint_origin_transform))
-      throw UrdfError(fileName + ": joint '" + excerpt(j->name) + "' has an origin that is not finite");
-    const Transform jointFrame = Transform(linkPose * toTransform(j->parent_to_joint_origin_transform));
+    const std::string joint = fileName + ": joint '" + excerpt(j->name) + "'";
+    if (!finite(j->parent_to_joint_origin_transform)) throw UrdfError(joint + " has an origin that is not finite");
+    const Transform origin = toTransform(j->parent_to_joint_origin_transform);
     switch (j->type) {
       case urdf::Joint::REVOLUTE:
       case urdf::Joint::CONTINUOUS:
       case urdf::Joint::PRISMATIC: {
+        if (j->mimic)
+          throw UrdfError(joint + " mimics joint '" + excerpt(j->mimic->joint_name) +
+                          "': a mimic joint is no independent joint of the arm, and mimic joints on the chain are not "
+                          "supported; name a tip link before it (links moved by mimic joints off the chain are lumped)");
         V3 axis(j->axis.x, j->axis.y, j->axis.z);
-        if (!axis.allFinite()) throw UrdfError(fileName + ": joint '" + excerpt(j->name) + "' has an axis that is not finite");
-        if (axis.norm() < 1e-12) throw UrdfError(fileName + ": joint '" + j->name + "' has a zero axis");
-        axis = jointFrame.topLeftCorner<3, 3>() * axis.normalized();
-        axes.push_back({V3(jointFrame.topRightCorner<3, 1>()), axis});
-        movable.push_back(j);
-        bodies.emplace_back();
+        if (!axis.allFinite()) throw UrdfError(joint + " has an axis that is not finite");
+        if (axis.norm() < 1e-12) throw UrdfError(joint + " has a zero axis");
+        const Eigen::Matrix3d Ra = axisRotation(axis.normalized());
+        ChainLink link;
+        link.joint = j;
+        link.placement = Transform(C * origin);
+        link.placement.topLeftCorner<3, 3>() = Eigen::Matrix3d(link.placement.topLeftCorner<3, 3>() * Ra);
+        links.push_back(std::move(link));
+        C = Transform::unit();
+        C.topLeftCorner<3, 3>() = Ra.transpose();
         break;
       }
       case urdf::Joint::FIXED:
+        C = Transform(C * origin);
         break;
       default:
-        throw UrdfError(fileName + ": joint '" + j->name +
-                        "' is floating or planar; a manipulator is a chain of revolute, continuous, prismatic and fixed joints");
+        throw UrdfError(joint + " is floating or planar; a manipulator is a chain of revolute, continuous, prismatic and fixed joints");
     }
-    linkPose = jointFrame;
-    addInertial(robot->getLink(j->child_link_name), linkPose);
+    addInertial(robot->getLink(j->child_link_name), C);
   }
-  const int n = static_cast<int>(axes.size());
+  const int n = static_cast<int>(links.size());
   if (n == 0) throw UrdfError(fileName + ": no revolute, continuous or prismatic joint between the root and '" + tip->name + "'");
   if (n > kMaxJoints) throw UrdfError(fileName + ": " + std::to_string(n) + " joints; at most " + std::to_string(kMaxJoints));
 
-  // Standard DH frames F_0..F_n in root coordinates (a prismatic joint's line is taken through its
-  // joint origin: only its direction matters): z_{i-1} along joint i's axis, x_i along the
-  // common normal from axis i to axis i+1, origin of F_i on axis i+1; F_n = F_{n-1}.
-  std::vector<Transform> F(static_cast<std::size_t>(n + 1));
-  std::vector<V3> origin(static_cast<std::size_t>(n + 1)), xs(static_cast<std::size_t>(n + 1));
-  for (int i = 1; i < n; ++i) {  // frame i from axes i-1 and i (0-based lines)
-    const Line& a = axes[static_cast<std::size_t>(i - 1)];
-    const Line& b = axes[static_cast<std::size_t>(i)];
-    const V3 cross = a.direction.cross(b.direction);
-    V3 o, x;
-    if (cross.norm() > 1e-9) {
-      // Closest points of the two lines.
-      const V3 w = a.point - b.point;
-      const double A = a.direction.dot(a.direction), B = a.direction.dot(b.direction), C = b.direction.dot(b.direction),
-                   D = a.direction.dot(w), E = b.direction.dot(w), den = A * C - B * B;
-      const double t = (B * E - C * D) / den, s = (A * E - B * D) / den;
-      const V3 pa = a.point + t * a.direction, pb = b.point + s * b.direction;
-      o = pb;
-      x = (pb - pa).norm() > 1e-9 ? V3((pb - pa).normalized()) : V3(cross.normalized());
-    } else {
-      // Parallel axes: origin where the perpendicular from the previous origin meets axis i.
-      const V3 prev = i == 1 ? a.point : origin[static_cast<std::size_t>(i - 1)];
-      const V3 foot = b.point + (prev - b.point).dot(b.direction) * b.direction;
-      o = foot;
-      const V3 between = foot - prev - (foot - prev).dot(a.direction) * a.direction;
-      x = between.norm() > 1e-9 ? V3(between.normalized()) : V3::Zero();
-    }
-    origin[static_cast<std::size_t>(i)] = o;
-    xs[static_cast<std::size_t>(i)] = x;
-  }
-  // Frame 0: on axis 0 with x along frame 1's x if that is perpendicular, else any perpendicular.
-  const V3 z0 = axes[0].direction;
-  V3 x0 = n > 1 && xs[1].norm() > 0.5 ? xs[1] : anyPerpendicular(z0);
-  x0 = (x0 - x0.dot(z0) * z0).normalized();
-  origin[0] = axes[0].point;
-  F[0] = frame(origin[0], z0, x0);
-  for (int i = 1; i < n; ++i) {
-    V3 x = xs[static_cast<std::size_t>(i)];
-    const V3 z = axes[static_cast<std::size_t>(i)].direction;
-    if (x.norm() < 0.5) x = F[static_cast<std::size_t>(i - 1)].block<3, 1>(0, 0);  // coincident axes: keep x
-    x = (x - x.dot(z) * z).normalized();
-    F[static_cast<std::size_t>(i)] = frame(origin[static_cast<std::size_t>(i)], z, x);
-  }
-  F[static_cast<std::size_t>(n)] = F[static_cast<std::size_t>(n - 1)];
-
-  std::vector<LinkParameters> links(static_cast<std::size_t>(n));
-  for (int i = 1; i <= n; ++i) {
-    const Transform& P = F[static_cast<std::size_t>(i - 1)];
-    const Transform& Q = F[static_cast<std::size_t>(i)];
-    const V3 zp = P.block<3, 1>(0, 2), xp = P.block<3, 1>(0, 0), zq = Q.block<3, 1>(0, 2), xq = Q.block<3, 1>(0, 0);
-    const V3 dp = Q.topRightCorner<3, 1>() - P.topRightCorner<3, 1>();
-    LinkParameters& l = links[static_cast<std::size_t>(i - 1)];
-    l.a = dp.dot(xq);
-    l.d = dp.dot(zp);
-    l.alpha = std::atan2(zp.cross(zq).dot(xq), zp.dot(zq));
-    l.offset = std::atan2(xp.cross(xq).dot(zp), xp.dot(xq));
-    const urdf::JointConstSharedPtr& j = movable[static_cast<std::size_t>(i - 1)];
-    // A prismatic joint slides along z_{i-1}, which moves the rest of the chain without changing
-    // the common normals: d_i = q_i + d (at q = 0 as measured) and theta_i = offset constant.
+  std::vector<LinkParameters> parameters(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const ChainLink& link = links[static_cast<std::size_t>(i)];
+    const urdf::JointConstSharedPtr& j = link.joint;
+    const std::string joint = fileName + ": joint '" + excerpt(j->name) + "'";
+    LinkParameters& l = parameters[static_cast<std::size_t>(i)];
+    l.placement = link.placement;
+    l.jointName = j->name;
+    l.linkName = j->child_link_name;
     if (j->type == urdf::Joint::PRISMATIC) l.type = JointType::Prismatic;
+    if (j->limits) {
+      for (const auto& [what, value] : {std::pair<const char*, double>{"lower", j->limits->lower}, {"upper", j->limits->upper},
+                                        {"effort", j->limits->effort}, {"velocity", j->limits->velocity}})
+        if (!std::isfinite(value)) throw UrdfError(joint + ": <limit> " + what + " is not a finite number");
+    }
+    if (j->dynamics && (!std::isfinite(j->dynamics->damping) || !std::isfinite(j->dynamics->friction)))
+      throw UrdfError(joint + ": <dynamics> damping or friction is not a finite number");
     if (j->type == urdf::Joint::CONTINUOUS || !j->limits) {
       l.positionMin = -2 * std::numbers::pi;
       l.positionMax = 2 * std::numbers::pi;
@@ -507,7 +713,7 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
       if (!(l.positionMin <= l.positionMax)) {
         char range[96];
         std::snprintf(range, sizeof range, "lower %g is above upper %g", l.positionMin, l.positionMax);
-        throw UrdfError(fileName + ": joint '" + excerpt(j->name) + "': <limit> " + range);
+        throw UrdfError(joint + ": <limit> " + range);
       }
     }
     if (j->limits && j->limits->effort > 0) l.torqueLimit = j->limits->effort;
@@ -517,38 +723,22 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
       l.coulombFrictionPositive = j->dynamics->friction;
       l.coulombFrictionNegative = -j->dynamics->friction;
     }
-    // Inertia of the link (and what is fixed to it) in DH frame i.
-    const Body& body = bodies[static_cast<std::size_t>(i - 1)];
-    const std::string childName = j->child_link_name;
-    if (!body.any) {
+    if (link.body.parts.empty()) {
       if (options.requireDynamics) {
-        throw UrdfError(fileName + ": link '" + childName + "' has no inertial data (needed for dynamics and simulation)");
+        throw UrdfError(fileName + ": link '" + j->child_link_name + "' has no inertial data (needed for dynamics and simulation)");
       }
       continue;
     }
-    // A massless link may still have rotational inertia (the Puma's link 1); its centre of mass
-    // is then immaterial and taken at the frame origin.
-    const V3 c = body.mass > 0 ? V3(body.moment / body.mass) : V3(Q.topRightCorner<3, 1>());
-    const Eigen::Matrix3d Ic =
-        body.inertiaAtOrigin - body.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
-    const Eigen::Matrix3d R = Q.topLeftCorner<3, 3>();
-    l.mass = body.mass;
-    l.com = Vector<3>(R.transpose() * (c - V3(Q.topRightCorner<3, 1>())));
-    l.inertia = Matrix<3, 3>(R.transpose() * Ic * R);
+    link.body.combine(l.mass, l.com, l.inertia);
   }
-  const Transform tool = Transform(rigidInverse(F[static_cast<std::size_t>(n)]) * linkPose);
   std::unique_ptr<ManipulatorModel> model;
   try {
-    model = std::make_unique<ManipulatorModel>(robot->getName(), links, F[0], tool);
+    model = std::make_unique<ManipulatorModel>(robot->getName(), parameters, Transform::unit(), C,
+                                               ManipulatorModel::standardGravity(), DHConvention::Placement);
   } catch (const std::invalid_argument& e) {  // whatever the model itself refuses, named by file
     throw UrdfError(fileName + ": " + e.what());
   }
-  // Self-check: the DH chain must reproduce the URDF's poses at q = 0.
-  ManipulatorData data(*model);
-  const Transform& T = forwardKinematics(*model, data, JointVector(n));
-  if ((T - linkPose).cwiseAbs().maxCoeff() > 1e-9) {
-    throw UrdfError(fileName + ": internal error converting the chain to DH frames");
-  }
+  selfCheck(*model, chain, fileName);
   return model;
 }
 

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <string>
 
@@ -112,6 +113,28 @@ TEST(UrdfVisuals, ErrorsNameTheFile) {
   }
   EXPECT_THROW(rp::loadUrdfVisuals(kArm, "no_such_link"), rp::UrdfError);
   EXPECT_TRUE(rp::loadUrdfVisuals(std::string(RP_SOURCE_DIR) + "/tests/model/data/prismatic_arm.urdf").empty());
+}
+
+// Issue 20: the visuals hang on the model's own joints, whatever tip loadUrdf() chose: an arm whose
+// last joint is a jaw ends before it (the jaw is lumped), and its shapes used to be refused with
+// "the chain to the tip does not match the model".
+TEST(UrdfVisuals, FollowTheDefaultTipOfTheModel) {
+  const std::string file = (std::filesystem::temp_directory_path() / "rp_urdf_visuals_jaw.urdf").string();
+  const std::string box = "<visual><geometry><box size=\"0.1 0.1 0.1\"/></geometry></visual>";
+  const std::string inertial = "<inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>";
+  std::ofstream(file) << "<robot name=\"jaw\"><link name=\"base\"/><link name=\"upper\">" << box << inertial
+                      << "</link><link name=\"stator\">" << box << "</link><link name=\"jaw_link\">" << inertial
+                      << "</link><joint name=\"shoulder\" type=\"revolute\"><parent link=\"base\"/><child link=\"upper\"/>"
+                         "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>"
+                         "<joint name=\"mount\" type=\"fixed\"><parent link=\"upper\"/><child link=\"stator\"/>"
+                         "<origin xyz=\"0.2 0 0\"/></joint><joint name=\"jaw_joint\" type=\"revolute\"><parent link=\"stator\"/>"
+                         "<child link=\"jaw_link\"/><axis xyz=\"0 1 0\"/><limit lower=\"-1\" upper=\"0\" effort=\"1\" "
+                         "velocity=\"1\"/></joint></robot>";
+  ASSERT_EQ(rp::loadUrdf(file)->getNumberOfJoints(), 1);
+  const auto shapes = rp::loadUrdfVisuals(file);
+  ASSERT_EQ(shapes.size(), 2u);
+  for (const auto& s : shapes) EXPECT_EQ(s.frame, "link1");
+  std::filesystem::remove(file);
 }
 
 }  // namespace

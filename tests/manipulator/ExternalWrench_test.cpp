@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "ModifiedDh.hpp"
+#include "PrismaticDhArm.hpp"
 #include "SimulatedArmTest.hpp"
 #include "rp/RoboticPlatform.hpp"
 
@@ -67,8 +68,8 @@ std::unique_ptr<ManipulatorModel> makeModel(int which) {
   o.tip = "tool";
   o.requireDynamics = true;
   std::unique_ptr<ManipulatorModel> prismatic = loadUrdf(RP_TEST_MODEL_DATA "/prismatic_arm.urdf", o);
-  if (which == 4) return prismatic;
-  return test::toModifiedDh(*prismatic);
+  if (which == 4) return prismatic;  // the Placement form
+  return test::toModifiedDh(*test::prismaticDhArm());
 }
 
 TEST_P(LinkWrench, JointTorquesMatchVirtualWork) {

@@ -28,7 +28,11 @@ set(cases
   "--robot ${DATA}/kinematic_loop.urdf fk --q 0,0"
   "--robot ${DATA}/nan_mass.urdf gravity --q 0"
   # Issue 23: an MJCF export needs the inertial data of every moving link.
-  "--robot ${DATA}/no_inertia.urdf mjcf")
+  "--robot ${DATA}/no_inertia.urdf mjcf"
+  # Issue 20: joint values by name: an unknown name, a joint left out, names mixed with positions.
+  "--robot ${DATA}/ur_like.urdf fk --q nosuch_joint=0"
+  "--robot puma560 fk --q joint1=0,joint2=0"
+  "--robot puma560 fk --q joint1=0,0,0,0,0,0")
 set(count 0)
 foreach(args IN LISTS cases)
   set(shown "${args}")
@@ -42,6 +46,6 @@ foreach(args IN LISTS cases)
   message("rp-model ${shown} -> ${err}")
   math(EXPR count "${count} + 1")
 endforeach()
-if(NOT count EQUAL 23)
-  message(FATAL_ERROR "${count} cases ran, expected 23")
+if(NOT count EQUAL 26)
+  message(FATAL_ERROR "${count} cases ran, expected 26")
 endif()

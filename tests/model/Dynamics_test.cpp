@@ -12,6 +12,7 @@
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "ModifiedDh.hpp"
+#include "PrismaticDhArm.hpp"
 #include "rp/model/Puma560Model.hpp"
 #include "rp/model/UrdfModel.hpp"
 #include "rp/model/WAMModel.hpp"
@@ -28,7 +29,10 @@ std::vector<std::unique_ptr<ManipulatorModel>> robots() {
   UrdfOptions o;
   o.tip = "tool";
   o.requireDynamics = true;
-  r.push_back(loadUrdf(std::string(RP_TEST_DATA_DIR) + "/prismatic_arm.urdf", o));
+  r.push_back(loadUrdf(std::string(RP_TEST_DATA_DIR) + "/prismatic_arm.urdf", o));  // the Placement form
+  o.tip = "tool0";
+  r.push_back(loadUrdf(std::string(RP_TEST_DATA_DIR) + "/noisy_axes_arm.urdf", o));
+  r.push_back(test::prismaticDhArm());
   r.push_back(test::toModifiedDh(*r.back()));
   // The WAM 7 on a tilted, shifted base with gravity off the vertical: the world-frame algorithms
   // (gravity from mass moments, forward dynamics) against the Newton-Euler one, which works in

@@ -1,6 +1,7 @@
 #pragma once
 // Builds an Orocos KDL chain from a ManipulatorModel's parameters with KDL's own API (KDL's DH
-// frames: Frame::DH for standard DH, Frame::DH_Craig1989 for modified DH; joints RotZ / TransZ or
+// frames: Frame::DH for standard DH, Frame::DH_Craig1989 for modified DH, the placement for the
+// Placement form; joints RotZ / TransZ or
 // about / along a KDL-computed axis; rigid-body inertias about the centre of mass; a fixed tool
 // segment), so that KDL is an independent reference for forward kinematics, Jacobians and
 // dynamics. Test and benchmark only.
@@ -41,9 +42,12 @@ inline KDL::Chain kdlChain(const ManipulatorModel& model) {
       const KDL::Joint joint(prismatic ? KDL::Joint::TransZ : KDL::Joint::RotZ);
       chain.addSegment(KDL::Segment(joint, KDL::Frame::DH(l.a, l.alpha, l.d, l.offset), inertia));
     } else {
-      // Rx(alpha) Tx(a) Rz(offset) Tz(d) at q = 0 (KDL's Craig frame); the joint moves about or along
-      // that frame's z axis, which KDL's Joint(origin, axis) expresses in the previous frame.
-      const KDL::Frame f0 = KDL::Frame::DH_Craig1989(l.a, l.alpha, l.d, l.offset);
+      // Rx(alpha) Tx(a) Rz(offset) Tz(d) at q = 0 (KDL's Craig frame), or the link's placement; the
+      // joint moves about or along that frame's z axis, which KDL's Joint(origin, axis) expresses in
+      // the previous frame.
+      const KDL::Frame f0 = model.getConvention() == DHConvention::Modified
+                                ? KDL::Frame::DH_Craig1989(l.a, l.alpha, l.d, l.offset)
+                                : kdlFrame(l.placement);
       const KDL::Joint joint("j", f0.p, f0.M.UnitZ(), prismatic ? KDL::Joint::TransAxis : KDL::Joint::RotAxis);
       chain.addSegment(KDL::Segment(joint, f0, inertia));
     }

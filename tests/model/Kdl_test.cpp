@@ -15,6 +15,7 @@
 
 #include "KdlChain.hpp"
 #include "ModifiedDh.hpp"
+#include "PrismaticDhArm.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/Puma560Model.hpp"
@@ -34,6 +35,7 @@ class KdlComparison : public ::testing::TestWithParam<std::string> {
     if (name == "puma560") m = std::make_unique<Puma560Model>();
     else if (name == "wam7") m = std::make_unique<WAM7Model>();
     else if (name == "wam4") m = std::make_unique<WAM4Model>();
+    else if (name == "prismatic_dh") m = test::prismaticDhArm();
     else {
       UrdfOptions o;
       o.tip = "tool";
@@ -132,7 +134,7 @@ TEST_P(KdlComparison, AgreesOnRandomConfigurations) {
 
 INSTANTIATE_TEST_SUITE_P(BuiltInRobots, KdlComparison, ::testing::Values("puma560", "wam7", "wam4"));
 INSTANTIATE_TEST_SUITE_P(ModifiedDh, KdlComparison, ::testing::Values("puma560_mdh", "wam7_mdh", "wam4_mdh"));
-INSTANTIATE_TEST_SUITE_P(Prismatic, KdlComparison, ::testing::Values("prismatic_arm", "prismatic_arm_mdh"));
+INSTANTIATE_TEST_SUITE_P(Prismatic, KdlComparison, ::testing::Values("prismatic_arm", "prismatic_dh", "prismatic_dh_mdh"));
 
 }  // namespace
 }  // namespace rp

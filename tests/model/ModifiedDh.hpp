@@ -6,6 +6,7 @@
 // link 1 gets a = alpha = 0, the centre of mass and inertia of link i move into M_i through
 // Tx(a_i) Rx(alpha_i), and the tool becomes Tx(a_n) Rx(alpha_n) tool. Test only.
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "rp/model/ManipulatorModel.hpp"
@@ -13,6 +14,7 @@
 namespace rp::test {
 
 inline std::unique_ptr<ManipulatorModel> toModifiedDh(const ManipulatorModel& standard) {
+  if (standard.getConvention() != DHConvention::Standard) throw std::invalid_argument("toModifiedDh: not a standard-DH model");
   const int n = standard.getNumberOfJoints();
   std::vector<LinkParameters> links;
   for (int i = 0; i < n; ++i) {

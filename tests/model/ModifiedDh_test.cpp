@@ -4,10 +4,14 @@
 // paths for the two conventions). KDL agreement is in Kdl_test.cpp.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <memory>
+#include <stdexcept>
 #include <random>
 
 #include "ModifiedDh.hpp"
+#include "PrismaticDhArm.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/Puma560Model.hpp"
@@ -71,9 +75,7 @@ TEST(ModifiedDh, Puma560SameAsStandard) { compare(Puma560Model(), 1000); }
 TEST(ModifiedDh, Wam7SameAsStandard) { compare(WAM7Model(), 1000); }
 
 TEST(ModifiedDh, PrismaticArmSameAsStandard) {
-  UrdfOptions o;
-  o.tip = "tool";
-  const std::unique_ptr<ManipulatorModel> arm = loadUrdf(std::string(RP_TEST_DATA_DIR) + "/prismatic_arm.urdf", o);
+  const std::unique_ptr<ManipulatorModel> arm = test::prismaticDhArm();
   // Its last DH link has a non-zero a or alpha, so link frame n (where a tip wrench acts) differs
   // between the conventions: compare without one.
   compare(*arm, 1000, false);
@@ -90,6 +92,68 @@ TEST(ModifiedDh, PumaModifiedParametersAreCraigs) {
   EXPECT_DOUBLE_EQ(m->getLink(3).a, 0.0203);
   EXPECT_DOUBLE_EQ(m->getLink(2).d, 0.15005);
   EXPECT_DOUBLE_EQ(m->getLink(3).d, 0.4318);
+}
+
+// Issue 20: the Placement form reproduces a modified-DH model exactly when given the same fixed
+// parts (they run the same code), and the constructor refuses what would make a wrong model.
+TEST(ManipulatorModel, PlacementFormIsCheckedAndKeepsNames) {
+  const std::unique_ptr<ManipulatorModel> mdh = test::toModifiedDh(Puma560Model());
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < mdh->getNumberOfJoints(); ++i) {
+    LinkParameters l = mdh->getLink(i);
+    l.placement = mdh->getPlacement(i);
+    l.a = l.alpha = l.d = l.offset = 0;
+    l.jointName = "j" + std::to_string(i);
+    l.linkName = "body" + std::to_string(i);
+    links.push_back(l);
+  }
+  const ManipulatorModel placed("placed", links, mdh->getBaseTransform(), mdh->getToolTransform(), mdh->getGravity(),
+                                DHConvention::Placement);
+  EXPECT_EQ(placed.getJointName(2), "j2");
+  EXPECT_EQ(placed.getLinkName(5), "body5");
+  EXPECT_EQ(placed.findJoint("j4"), 4);
+  EXPECT_EQ(placed.findJoint("joint4"), -1);
+  EXPECT_EQ(mdh->getJointName(0), "joint1");
+  EXPECT_EQ(mdh->getLinkName(0), "link1");
+  ManipulatorData a(*mdh), b(placed);
+  JointVector q(6), qd(6), qdd(6);
+  for (int i = 0; i < 6; ++i) {
+    q(i) = 0.4 * i - 1;
+    qd(i) = 0.3 - 0.1 * i;
+    qdd(i) = 0.2 * i;
+  }
+  EXPECT_EQ(forwardKinematics(*mdh, a, q), forwardKinematics(placed, b, q));
+  EXPECT_EQ(inverseDynamics(*mdh, a, q, qd, qdd), inverseDynamics(placed, b, q, qd, qdd));
+
+  auto refused = [&](std::vector<LinkParameters> l, DHConvention c) -> std::string {
+    try {
+      ManipulatorModel("bad", std::move(l), Transform::unit(), Transform::unit(), ManipulatorModel::standardGravity(), c);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  std::vector<LinkParameters> bad = links;
+  bad[1].placement(0, 0) = 2;  // not a rotation
+  EXPECT_EQ(refused(bad, DHConvention::Placement).rfind("ManipulatorModel 'bad' joint 2 ('j1'): the placement is not a rigid transform", 0), 0u);
+  bad = links;
+  bad[2].a = 0.1;
+  EXPECT_EQ(refused(bad, DHConvention::Placement),
+            "ManipulatorModel 'bad' joint 3 ('j2'): DH parameters (a, alpha, d, offset) given with DHConvention::Placement");
+  EXPECT_EQ(refused(links, DHConvention::Modified),
+            "ManipulatorModel 'bad' joint 1 ('j0'): a placement given with DH parameters (use DHConvention::Placement)");
+  bad = links;
+  bad[3].inertia(1, 1) = std::nan("");
+  EXPECT_EQ(refused(bad, DHConvention::Placement), "ManipulatorModel 'bad' joint 4 ('j3'): a parameter is not a finite number");
+  bad = links;
+  bad[4].placement(1, 3) = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(refused(bad, DHConvention::Placement), "ManipulatorModel 'bad' joint 5 ('j4'): a parameter is not a finite number");
+  bad = links;
+  bad[5].jointName = "j0";
+  EXPECT_EQ(refused(bad, DHConvention::Placement), "ManipulatorModel 'bad' joint 6 ('j0'): a second joint named 'j0'");
+  bad = links;
+  bad[5].linkName = "body1";
+  EXPECT_EQ(refused(bad, DHConvention::Placement), "ManipulatorModel 'bad' joint 6 ('j5'): a second link named 'body1'");
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "rp/model/InverseKinematics.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "ModifiedDh.hpp"
+#include "PrismaticDhArm.hpp"
 #include "rp/model/Puma560Model.hpp"
 #include "rp/model/UrdfModel.hpp"
 #include "rp/model/WAMModel.hpp"
@@ -123,8 +124,11 @@ TEST(NumericIk, PrismaticArmsInBothConventions) {
   UrdfOptions o;
   o.tip = "tool";
   const std::unique_ptr<ManipulatorModel> arm = loadUrdf(std::string(RP_TEST_DATA_DIR) + "/prismatic_arm.urdf", o);
-  const double standard = solveRate(*arm, kPoses / 10, false);
-  const double modified = solveRate(*test::toModifiedDh(*arm), kPoses / 10, false);
+  const double placement = solveRate(*arm, kPoses / 10, false);
+  const double standard = solveRate(*test::prismaticDhArm(), kPoses / 10, false);
+  const double modified = solveRate(*test::toModifiedDh(*test::prismaticDhArm()), kPoses / 10, false);
+  std::cout << "prismatic arm from URDF full pose: " << placement << std::endl;
+  EXPECT_GE(placement, 0.995);
   std::cout << "prismatic arm full pose: " << standard << " (standard DH), " << modified << " (modified DH)" << std::endl;
   EXPECT_GE(standard, 0.995);
   EXPECT_GE(modified, 0.995);

@@ -293,8 +293,6 @@ TEST(UrdfModel, BadFilesGiveClearErrors) {
   EXPECT_EQ(message(kData + "/missing.urdf"), kData + "/missing.urdf: cannot read the file");
   EXPECT_NE(message(kData + "/bad_xml.urdf").find("not a valid URDF document"), std::string::npos);
   EXPECT_NE(message(kData + "/floating.urdf").find("joint 'free' is floating or planar"), std::string::npos);
-  EXPECT_NE(message(kData + "/test_arm.urdf").find("the robot branches at link 'l3'; name the tip link"),
-            std::string::npos);
   UrdfOptions unknownTip;
   unknownTip.tip = "gripper";
   EXPECT_NE(message(kData + "/test_arm.urdf", unknownTip).find("there is no link 'gripper'"), std::string::npos);
@@ -302,6 +300,124 @@ TEST(UrdfModel, BadFilesGiveClearErrors) {
   dynamics.requireDynamics = true;
   EXPECT_NE(message(kData + "/no_inertia.urdf", dynamics).find("link 'b' has no inertial data"), std::string::npos);
   EXPECT_EQ(message(kData + "/no_inertia.urdf"), "no error") << "kinematics only is fine";
+}
+
+// Issue 20: a branch that carries only fixed frames (a camera, tool0, a base frame) is no branch:
+// without a tip the arm runs to its last moving link, and stops before a gripper, whose moving
+// links are lumped with a note.
+TEST(UrdfModel, DefaultTipIgnoresBranchesOfFixedFramesAndStopsBeforeGrippers) {
+  std::vector<std::string> notes;
+  UrdfOptions options;
+  options.notes = &notes;
+  std::unique_ptr<ManipulatorModel> model = loadUrdf(kData + "/test_arm.urdf", options);  // a camera on l3
+  ASSERT_EQ(model->getNumberOfJoints(), 6);
+  EXPECT_EQ(model->getLinkName(5), "l6");
+  model = loadUrdf(kData + "/ur_like.urdf", options);  // fixed frames at the base and the wrist
+  ASSERT_EQ(model->getNumberOfJoints(), 6);
+  EXPECT_EQ(model->getJointName(0), "shoulder_pan_joint");
+  EXPECT_EQ(model->getLinkName(5), "wrist_3_link");
+  UrdfOptions explicitTip;
+  explicitTip.tip = "wrist_3_link";
+  const std::unique_ptr<ManipulatorModel> same = loadUrdf(kData + "/ur_like.urdf", explicitTip);
+  ManipulatorData a(*model), b(*same);
+  const JointVector q = JointVector::Constant(6, 0.3);
+  EXPECT_EQ(forwardKinematics(*model, a, q), forwardKinematics(*same, b, q));
+  EXPECT_TRUE(notes.empty());
+  model = loadUrdf(kData + "/jaw_arm.urdf", options);
+  ASSERT_EQ(model->getNumberOfJoints(), 6);
+  EXPECT_EQ(model->getLinkName(5), "link06");
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0], kData + "/jaw_arm.urdf: links 'gripperMover' move off the chain: their mass is lumped into 'link06' "
+                              "at jointGripper = 0 (UrdfOptions::offChainPositions sets other values)");
+  notes.clear();
+  model = loadUrdf(kData + "/panda_like.urdf", options);
+  ASSERT_EQ(model->getNumberOfJoints(), 7);
+  EXPECT_EQ(model->getLinkName(6), "link7");
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("links 'leftfinger', 'rightfinger' move off the chain: their mass is lumped into 'link7' at "
+                          "finger_joint1 = 0, finger_joint2 = 0"),
+            std::string::npos)
+      << notes[0];
+}
+
+// Moving links off the chain are lumped at the stated configuration: the jaw arm's gravity torque
+// with its jaw lumped equals the seven-joint arm's (jaw a joint) at the same jaw angle; a mimic
+// finger follows its master (multiplier and offset); mimics naming a missing joint, going round in
+// a circle or lying on the chain are refused.
+TEST(UrdfModel, MovingLinksOffTheChainAreLumpedAtTheStatedConfiguration) {
+  UrdfOptions withJaw;
+  withJaw.tip = "gripperMover";
+  withJaw.requireDynamics = true;
+  const std::unique_ptr<ManipulatorModel> seven = loadUrdf(kData + "/jaw_arm.urdf", withJaw);
+  ASSERT_EQ(seven->getNumberOfJoints(), 7);
+  ManipulatorData d7(*seven);
+  for (const double jaw : {0.0, -0.8}) {
+    UrdfOptions lumped;
+    lumped.tip = "link06";
+    lumped.requireDynamics = true;
+    if (jaw != 0.0) lumped.offChainPositions["jointGripper"] = jaw;
+    const std::unique_ptr<ManipulatorModel> six = loadUrdf(kData + "/jaw_arm.urdf", lumped);
+    ASSERT_EQ(six->getNumberOfJoints(), 6);
+    ManipulatorData d6(*six);
+    JointVector q6(6), q7(7), g6(6), g7(7);
+    for (int i = 0; i < 6; ++i) q6(i) = q7(i) = 0.3 * (i + 1) - 1;
+    q7(6) = jaw;
+    gravityTorque(*six, d6, q6, g6);
+    gravityTorque(*seven, d7, q7, g7);
+    for (int i = 0; i < 6; ++i) EXPECT_NEAR(g6(i), g7(i), 1e-12 * (1 + std::abs(g7(i)))) << "joint " << i + 1 << " jaw " << jaw;
+    // Link 6 carries the stator and the 0.276 kg jaw (the jaw used to be dropped).
+    EXPECT_NEAR(six->getLink(5).mass, 0.34 + 0.52 + 0.276, 1e-12);
+  }
+  const std::string text = [] {
+    std::ifstream in(kData + "/panda_like.urdf");
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }();
+  auto variant = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    const std::size_t at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    t.replace(at, from.size(), to);
+    const std::string file = testing::TempDir() + "/panda_variant.urdf";
+    std::ofstream(file) << t;
+    return file;
+  };
+  auto error = [](const std::string& file, const std::string& tip = "") -> std::string {
+    try {
+      UrdfOptions o;
+      o.tip = tip;
+      loadUrdf(file, o);
+    } catch (const UrdfError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  // The mimic finger at multiplier 2 and offset 0.01 with its master at 0.015: the right finger sits
+  // at 0.04 along -y, which moves the lumped centre of mass by the same as moving it by hand.
+  std::string f = variant("<mimic joint=\"finger_joint1\"/>", "<mimic joint=\"finger_joint1\" multiplier=\"2\" offset=\"0.01\"/>");
+  UrdfOptions open;
+  open.offChainPositions["finger_joint1"] = 0.015;
+  std::vector<std::string> notes;
+  open.notes = &notes;
+  const std::unique_ptr<ManipulatorModel> a = loadUrdf(f, open);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("finger_joint1 = 0.015, finger_joint2 = 0.04"), std::string::npos) << notes[0];
+  const std::unique_ptr<ManipulatorModel> closed = loadUrdf(kData + "/panda_like.urdf");
+  // Finger masses 0.015 each, hand rotated -45 deg about z in link7: the fingers open along the
+  // hand's y axis by 0.015 (left, +y) and 0.04 (right, -y).
+  const double m = a->getLink(6).mass;
+  const Eigen::Vector3d shift = (Eigen::Vector3d(a->getLink(6).com) - Eigen::Vector3d(closed->getLink(6).com)) * m;
+  const Eigen::Vector3d handY(std::sin(0.7853981633974483), std::cos(0.7853981633974483), 0);  // Rz(-45 deg) y
+  EXPECT_LT((shift - 0.015 * (0.015 - 0.04) * handY).norm(), 1e-12) << shift.transpose();
+  f = variant("<mimic joint=\"finger_joint1\"/>", "<mimic joint=\"no_such_joint\"/>");
+  EXPECT_EQ(error(f), f + ": joint 'finger_joint2' mimics joint 'no_such_joint', which does not exist");
+  f = variant("<mimic joint=\"finger_joint1\"/>", "<mimic joint=\"finger_joint2\"/>");
+  EXPECT_EQ(error(f), f + ": joint 'finger_joint2' mimics 'finger_joint2': the mimic joints go round in a circle");
+  EXPECT_EQ(error(kData + "/panda_like.urdf", "rightfinger"),
+            kData + "/panda_like.urdf: joint 'finger_joint2' mimics joint 'finger_joint1': a mimic joint is no "
+                    "independent joint of the arm, and mimic joints on the chain are not supported; name a tip link "
+                    "before it (links moved by mimic joints off the chain are lumped)");
 }
 
 // Issue 19: bad URDF files never hang or crash the process.
@@ -375,6 +491,20 @@ TEST_F(UrdfInputTest, KinematicLoopsAreRefused) {
 }
 
 // What urdfdom would refuse only after building part of the tree is refused before it.
+// Issue 20: two moving chains that are not a gripper are a real choice: the message lists the tips.
+TEST_F(UrdfInputTest, ARealBranchListsTheCandidateTips) {
+  const std::string f = write("two.urdf", "<robot name=\"two\"><link name=\"base\"/><link name=\"torso\"/><link name=\"left1\"/>"
+                                          "<link name=\"left2\"/><link name=\"right1\"/><link name=\"camera\"/>" +
+                                              joint("waist", "revolute", "base", "torso") + joint("l1", "revolute", "torso", "left1") +
+                                              joint("l2", "revolute", "left1", "left2") + joint("r1", "revolute", "torso", "right1") +
+                                              joint("cam", "fixed", "torso", "camera") + "</robot>");
+  EXPECT_EQ(message(f), f + ": the robot branches at link 'torso' into 2 moving chains; name the tip link, one of "
+                            "'camera', 'left2', 'right1'");
+  UrdfOptions tip;
+  tip.tip = "left2";
+  EXPECT_EQ(message(f, tip), "no error");
+}
+
 TEST_F(UrdfInputTest, JointsMustNameDefinedLinksAndOneRoot) {
   const std::string base = "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/>";
   std::string f = write("j.urdf", base + joint("j", "revolute", "a", "c") + "</robot>");
@@ -437,6 +567,30 @@ TEST_F(UrdfInputTest, NonFiniteInertialsAreRefusedWithTheLinkName) {
   f = arm(inertial("2", "1", "<origin xyz=\"0 0.1 0\" rpy=\"0 0 1\"/>"));
   EXPECT_EQ(message(f), "no error");
   EXPECT_NEAR(loadUrdf(f)->getLink(0).mass, 2.0, 1e-12);
+}
+
+// Issue 20: a joint with a number that is not finite is refused naming the file and the joint
+// (urdfdom refused a <limit> of nan only as "not a valid URDF document").
+TEST_F(UrdfInputTest, NonFiniteJointNumbersAreRefusedWithTheJointName) {
+  auto arm = [&](const std::string& jointXml) {
+    return write("arm.urdf", "<robot name=\"arm\"><link name=\"base\"/><link name=\"upper\"/><joint name=\"shoulder\" "
+                             "type=\"revolute\"><parent link=\"base\"/><child link=\"upper\"/>" +
+                                 jointXml + "</joint></robot>");
+  };
+  std::string f = arm("<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"nan\" velocity=\"1\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <limit> effort is not a finite number ('nan')");
+  f = arm("<axis xyz=\"0 0 1\"/><limit lower=\"-inf\" upper=\"1\" effort=\"1\" velocity=\"1\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <limit> lower is not a finite number ('-inf')");
+  f = arm("<axis xyz=\"0 0 1\"/><dynamics damping=\"1e999\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <dynamics> damping is not a finite number ('1e999')");
+  f = arm("<axis xyz=\"0 nan 1\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <axis> xyz '0 nan 1' is not three finite numbers");
+  f = arm("<origin xyz=\"0 0 0.1\" rpy=\"0 inf 0\"/><axis xyz=\"0 0 1\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <origin> rpy '0 inf 0' is not three finite numbers");
+  f = arm("<axis xyz=\"0 0 1\"/><mimic joint=\"shoulder\" multiplier=\"nan\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <mimic> multiplier is not a finite number ('nan')");
+  f = arm("<axis xyz=\"0 -1 -4.37114e-08\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>");
+  EXPECT_EQ(message(f), "no error");
 }
 
 TEST_F(UrdfInputTest, SpecialDeepAndHugeFilesAreRefused) {

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <memory>
 #include <vector>
 
 #include "AllocationCounter.hpp"
@@ -109,6 +110,44 @@ TEST(ModelRealtime, PrismaticAndModifiedDhAlgorithmsDoNotAllocate) {
     sink += forwardDynamics(arm, d, q, qd, out, all)(3);
     sink += forwardDynamicsArticulatedBody(arm, d, q, qd, out, all)(3);
     sink += inverseKinematics(arm, d, target, q, out, position) == IkStatus::Solved;
+  }
+  EXPECT_EQ(guard.count(), 0u);
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+// Issue 20: an arm loaded from URDF (the Placement form) runs every algorithm without allocating.
+TEST(ModelRealtime, UrdfArmAlgorithmsDoNotAllocate) {
+  UrdfOptions options;
+  options.tip = "tool0";
+  options.requireDynamics = true;
+  const std::unique_ptr<ManipulatorModel> arm = loadUrdf(RP_TEST_MODEL_DATA "/noisy_axes_arm.urdf", options);
+  const int n = arm->getNumberOfJoints();
+  ManipulatorData d(*arm);
+  JointVector q(n), qd(n), qdd(n), out(n);
+  for (int i = 0; i < n; ++i) {
+    q(i) = 0.2 * i - 0.5;
+    qd(i) = 0.1 * i;
+    qdd(i) = -0.1;
+  }
+  Vector<6> wrench;
+  wrench(1) = 3;
+  DynamicsOptions all;
+  all.motorInertia = true;
+  all.friction = true;
+  const Transform target = forwardKinematics(*arm, d, JointVector::Constant(n, 0.1));
+  double sink = 0;
+  test::AllocationGuard guard;
+  for (int i = 0; i < 100; ++i) {
+    sink += forwardKinematics(*arm, d, q)(0, 3);
+    sink += jacobian(*arm, d, q, ReferenceFrame::EndEffector)(0, 1);
+    endEffectorForceToJointTorque(*arm, d, q, wrench, out);
+    sink += inverseDynamics(*arm, d, q, qd, qdd, all)(1);
+    gravityTorque(*arm, d, q, out);
+    coriolisTorque(*arm, d, q, qd, out);
+    sink += massMatrix(*arm, d, q, true)(1, 1);
+    sink += forwardDynamics(*arm, d, q, qd, out, all)(3);
+    sink += forwardDynamicsArticulatedBody(*arm, d, q, qd, out, all)(3);
+    sink += inverseKinematics(*arm, d, target, q, out) == IkStatus::Solved;
   }
   EXPECT_EQ(guard.count(), 0u);
   EXPECT_TRUE(std::isfinite(sink));

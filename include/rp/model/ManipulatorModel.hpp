@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The constant description of a serial manipulator: kinematics (Denavit-Hartenberg), dynamics,
-/// drive train and limits (paper section 3.3, Figure 7).
+/// The constant description of a serial manipulator: kinematics (Denavit-Hartenberg or general
+/// placements), dynamics, drive train and limits (paper section 3.3, Figure 7).
 
 #include <string>
 #include <vector>
@@ -20,7 +20,8 @@ using JointMatrix = BoundedMatrix<kMaxJoints, kMaxJoints>;
 /// A geometric Jacobian: 6 rows (vx, vy, vz, wx, wy, wz), one column per joint (never allocates).
 using Jacobian = Matrix<6, Dynamic, double, 6, kMaxJoints>;
 
-/// Which Denavit-Hartenberg convention the link parameters follow.
+/// How the link parameters describe the kinematics: one of the Denavit-Hartenberg conventions, or
+/// a general fixed placement per link (the form of a URDF chain).
 enum class DHConvention {
   /// Standard (distal) DH: \f$A_i = R_z(\theta_i) T_z(d_i) T_x(a_i) R_x(\alpha_i)\f$; link frame
   /// \f$i\f$ sits at the distal end of link \f$i\f$ and joint \f$i\f$ turns about \f$z_{i-1}\f$.
@@ -30,6 +31,13 @@ enum class DHConvention {
   /// \f$i\f$ moves about or along \f$z_i\f$. LinkParameters `a` and `alpha` of link \f$i\f$ hold
   /// \f$a_{i-1}\f$ and \f$\alpha_{i-1}\f$ (the Robotics Toolbox's `RevoluteMDH` convention).
   Modified,
+  /// No DH parameters: \f$A_i = P_i\,J(q_i)\f$ with \f$P_i\f$ the link's `placement` (any
+  /// rigid transform: the pose of joint \f$i\f$'s frame in link frame \f$i-1\f$) and
+  /// \f$J(q_i) = R_z(q_i)\f$ or \f$T_z(q_i)\f$: joint \f$i\f$ turns about or slides along the
+  /// z axis of that frame, and link frame \f$i\f$ is the frame after the motion (as in KDL's
+  /// segments and Pinocchio's joint placements). Exact for any chain, whatever its axes: loadUrdf()
+  /// builds this form. `a`, `alpha`, `d` and `offset` are then zero.
+  Placement,
 };
 
 /// The kind of a joint.
@@ -70,11 +78,17 @@ struct LinkParameters {
   double jerkLimit = 100.0;                 ///< largest joint jerk for trajectories [rad/s^3]
   double torqueLimit = 100.0;               ///< largest joint torque [N m]
   JointType type = JointType::Revolute;     ///< revolute or prismatic joint
+
+  /// DHConvention::Placement only (the unit transform otherwise): the pose of joint i's frame in
+  /// link frame i-1 at \f$q_i = 0\f$ (link frame 0 is the base frame) [m].
+  Transform placement = Transform::unit();
+  std::string jointName;  ///< name of joint i (unique in the model); empty: `joint1`, `joint2`, ...
+  std::string linkName;   ///< name of link i, the body joint i moves (unique); empty: `link1`, `link2`, ...
 };
 
 /// The constant model of a serial manipulator with revolute and prismatic joints: Denavit-Hartenberg
-/// (standard or modified)
-/// kinematics, rigid-body dynamics, motor inertia, friction and limits, a base transform (the
+/// (standard or modified) or general-placement (DHConvention::Placement) kinematics, rigid-body
+/// dynamics, motor inertia, friction and limits, a base transform (the
 /// robot's pose in the world) and a tool transform (end-effector relative to the last link frame).
 ///
 /// A model never changes after construction; algorithms (forwardKinematics(), inverseDynamics(),
@@ -89,8 +103,10 @@ class ManipulatorModel {
   /// @param[in] tool        pose of the end-effector in the last link frame [m]
   /// @param[in] gravity     gravity acceleration in the world frame [m/s^2]
   /// @param[in] convention  DH convention of `links`
-  /// @throws std::invalid_argument for 0 or more than kMaxJoints links, a negative mass, or
-  ///         limits with min > max
+  /// @throws std::invalid_argument for 0 or more than kMaxJoints links, a number that is not
+  ///         finite, a negative mass, limits with min > max, a placement that is not a rigid
+  ///         transform (or one given with a DH convention, or DH parameters given with
+  ///         DHConvention::Placement), or two joints or two links of the same name
   ManipulatorModel(std::string name, std::vector<LinkParameters> links, const Transform& base = Transform::unit(),
                    const Transform& tool = Transform::unit(), const Vector<3>& gravity = standardGravity(),
                    DHConvention convention = DHConvention::Standard);
@@ -113,6 +129,19 @@ class ManipulatorModel {
   const LinkParameters& getLink(int i) const { return links_[static_cast<std::size_t>(i)]; }
   /// DH convention. Real-time safe: yes.
   DHConvention getConvention() const { return convention_; }
+  /// Name of joint `i` (from 0): the URDF joint name, or `joint1`, `joint2`, ... Real-time safe: yes.
+  const std::string& getJointName(int i) const { return getLink(i).jointName; }
+  /// Name of link `i` (from 0), the body joint `i` moves: the URDF link name, or `link1`, ...
+  /// Real-time safe: yes.
+  const std::string& getLinkName(int i) const { return getLink(i).linkName; }
+  /// The joint (from 0) named `name`, or -1. Real-time safe: no.
+  /// @param[in] name  a joint name
+  int findJoint(const std::string& name) const;
+  /// The fixed part \f$P_i\f$ of link `i`'s transform \f$A_i = P_i\,J(q_i)\f$ for the modified DH
+  /// (\f$R_x(\alpha) T_x(a) R_z(\mathrm{offset}) T_z(d)\f$) and Placement conventions; for
+  /// standard DH, whose fixed parts lie on both sides of the motion, the unit transform.
+  /// Real-time safe: yes.
+  const Transform& getPlacement(int i) const { return placements_[static_cast<std::size_t>(i)]; }
   /// Whether joint `i` (from 0) is prismatic. Real-time safe: yes.
   bool isPrismatic(int i) const { return getLink(i).type == JointType::Prismatic; }
   /// Pose of the base in the world [m]. Real-time safe: yes.
@@ -158,6 +187,7 @@ class ManipulatorModel {
   Transform base_, tool_;
   Vector<3> gravity_;
   DHConvention convention_;
+  std::vector<Transform> placements_;
   JointVector qmin_, qmax_, vmax_, amax_, jmax_, taumax_, armature_, home_, cosAlpha_, sinAlpha_;
 };
 

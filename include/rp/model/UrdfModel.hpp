@@ -2,9 +2,11 @@
 /// @file
 /// Loading a manipulator model from a URDF file (liburdfdom), for any serial arm.
 
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "rp/model/ManipulatorModel.hpp"
 
@@ -20,28 +22,51 @@ class UrdfError : public std::runtime_error {
 
 /// Options of loadUrdf().
 struct UrdfOptions {
-  std::string tip;               ///< last link of the chain; empty: the last movable link of an unbranched chain
+  /// Last link of the chain. Empty: from the root, follow the one child joint below which
+  /// something moves (a branch of fixed frames only, such as `tool0` or a camera, is no branch)
+  /// to the last moving link. Where everything that moves further on is a gripper (joints or
+  /// links named grip..., finger, jaw or claw), the arm ends there and the gripper is lumped
+  /// (see `notes`); where two or more other moving chains branch off, the load is refused with
+  /// the leaf links below as candidate tips.
+  std::string tip;
   bool requireDynamics = false;  ///< refuse links without inertial data (simulation needs them)
+  /// Receives what the loader decided on its own that a user should know (which moving links off
+  /// the chain it lumped, at which joint values); may be null.
+  std::vector<std::string>* notes = nullptr;
+  /// Values of moving joints off the chain (fingers, a jaw) at which the links they move are
+  /// lumped into the chain link they hang on, by joint name [rad or m]. A joint not named here is
+  /// at zero (within its limits); a mimic joint follows its master (multiplier and offset).
+  std::map<std::string, double> offChainPositions;
 };
 
 /// Loads the serial chain from the URDF root link to a tip link as a ManipulatorModel.
 ///
 /// Revolute, continuous and prismatic joints become the model's joints, fixed joints are merged
-/// into the links around them (their inertias combined about the common centre of mass), and the
-/// chain is re-expressed in standard Denavit-Hartenberg frames (always possible): the
-/// base transform places DH frame 0 in the URDF root frame and the tool transform places the tip
-/// link in the last DH frame, so forward kinematics equals the URDF's for every joint vector and
-/// joint values keep the URDF's zero and sign (a prismatic joint's value in metres along its
-/// axis). Limits come from `<limit>` (continuous joints get
+/// into the links around them (their inertias combined about the common centre of mass), links
+/// moved by joints off the chain (fingers, a jaw) are lumped into the chain link they hang on at
+/// a stated configuration (UrdfOptions::offChainPositions; zero by default; mimic joints follow
+/// their master) and named in a note, and the
+/// chain is kept as the file says it (DHConvention::Placement): each joint's fixed placement, then
+/// its motion about or along its axis, as in KDL and Pinocchio, so that any chain loads exactly,
+/// whatever its axes (nearly parallel, nearly intersecting, with float noise such as
+/// `axis xyz="0 -1 -4.37114e-08"`). Model link frame i is the child link of joint i turned so that
+/// its z axis is the joint's axis (unturned when the axis is z); the base transform is the unit
+/// transform (the URDF root frame is the model's base) and the tool transform places the tip
+/// link in the last link frame, so forward kinematics equals the URDF's for every joint vector
+/// and joint values keep the URDF's zero and sign (a prismatic joint's value in metres along its
+/// axis). Joint and link names are the URDF's. Limits come from `<limit>` (continuous joints get
 /// +-2 pi; a missing effort or velocity the ManipulatorModel defaults); `<dynamics damping
-/// friction>` become viscous and Coulomb friction.
+/// friction>` become viscous and Coulomb friction. Before returning, the model's forward
+/// kinematics is compared with the description's at the zero configuration and at four others
+/// spread over the joint ranges.
 /// @param[in] fileName  path of the URDF file
 /// @param[in] options   tip link and whether dynamics are required
 /// @return the model, named after the robot
 /// @throws UrdfError naming the file for: a missing or unreadable file, malformed XML or URDF, a
 ///         floating or planar joint in the chain, an unknown tip, a branching robot
-///         without a tip, no movable joint, and (with requireDynamics) a moving link without
-///         inertial data
+///         without a tip, no movable joint, a number that is not finite (naming the joint or
+///         link), a mimic joint naming a missing joint (or mimics in a circle), a mimic joint on
+///         the chain, and (with requireDynamics) a moving link without inertial data
 /// Real-time safe: no.
 std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options = UrdfOptions());
 
