@@ -99,6 +99,9 @@ DynamicsOptions options(bool gravity, bool motorInertia, bool friction) {
 py::dict linkDict(const LinkParameters& l) {
   py::dict d;
   d["type"] = l.type == JointType::Prismatic ? "prismatic" : "revolute";
+  d["joint_name"] = l.jointName;
+  d["link_name"] = l.linkName;
+  d["placement"] = fromMatrix(l.placement);
   d["a"] = l.a;
   d["alpha"] = l.alpha;
   d["d"] = l.d;
@@ -148,6 +151,20 @@ void bindModels(py::module_& m) {
                              [](const PyModel& p) {
                                return p.model->getConvention() == DHConvention::Standard ? "standard" : "modified";
                              })
+      .def_property_readonly("joint_names",
+                             [](const PyModel& p) {
+                               std::vector<std::string> names;
+                               for (int i = 0; i < p.dof(); ++i) names.push_back(p.model->getJointName(i));
+                               return names;
+                             },
+                             "the joints' names (the URDF's; joint1... for the built-in arms)")
+      .def_property_readonly("link_names",
+                             [](const PyModel& p) {
+                               std::vector<std::string> names;
+                               for (int i = 0; i < p.dof(); ++i) names.push_back(p.model->getLinkName(i));
+                               return names;
+                             },
+                             "the moving links' names")
       .def_property_readonly("home", [](const PyModel& p) { return fromVector(p.model->getHomePosition()); })
       .def_property_readonly("position_min", [](const PyModel& p) { return fromVector(p.model->getPositionMin()); })
       .def_property_readonly("position_max", [](const PyModel& p) { return fromVector(p.model->getPositionMax()); })

@@ -33,7 +33,7 @@ class RpDevice : public ::testing::Test {
     std::vector<std::string> argv{RP_DEVICE_PATH};
     argv.insert(argv.end(), args.begin(), args.end());
     test::ChildProcess child(argv);
-    const std::string line = child.readLine(10000).value_or("");
+    const std::string line = child.readLine(30000).value_or("");
     return {child.wait(10000).value_or(-1), line};
   }
   // Runs rp-device with stderr on the same pipe: (exit status, first line of stdout or stderr).
@@ -41,7 +41,7 @@ class RpDevice : public ::testing::Test {
     std::vector<std::string> argv{RP_DEVICE_PATH};
     argv.insert(argv.end(), args.begin(), args.end());
     test::ChildProcess child(argv, true);
-    const std::string line = child.readLine(10000).value_or("");
+    const std::string line = child.readLine(30000).value_or("");
     return {child.wait(10000).value_or(-1), line};
   }
   std::string file_;
@@ -60,7 +60,7 @@ class RpDeviceThroughHwServer : public RpDevice {
     server_ = std::make_unique<test::ChildProcess>(std::vector<std::string>{
         RP_HWSERVER_PATH, "-name", name_, "-rate", "20", "-board", "modbus", "-port", std::to_string(port), "-timeout",
         "200", "-watchdog", "5000", "-coils", coils, "-discreteInputs", "0"});
-    const auto line = server_->readLine(10000);
+    const auto line = server_->readLine(30000);
     ASSERT_TRUE(line.has_value() && contains(*line, "serving")) << line.value_or("(nothing)");
   }
   void TearDown() override {
@@ -81,7 +81,7 @@ TEST_F(RpDeviceThroughHwServer, CommandIsDoneOnlyWhenTheBoardHasIt) {
   const auto cfg = writeConfig("[changer]\nclass DefaultToolChanger\nboard hwserver\nserver " + name_ +
                                "\nlockLine 0\nunlockLine 1\n");
   test::ChildProcess child({RP_DEVICE_PATH, "-config", cfg, "changer", "Unlock"});
-  EXPECT_EQ(child.readLine(10000).value_or("(nothing)"), "changer: Unlock done");
+  EXPECT_EQ(child.readLine(30000).value_or("(nothing)"), "changer: Unlock done");
   EXPECT_EQ(device.coilSwitchedOn(1), 1) << "the unlock coil was set before 'done'";
   EXPECT_EQ(device.coilSwitchedOn(0), 0);
   EXPECT_EQ(child.wait(10000), 0);

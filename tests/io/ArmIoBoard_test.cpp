@@ -86,7 +86,7 @@ TEST(RpHwServer, PumaBackendMovesTheArmOnDacVolts) {
   // A long client watchdog: this test is not about it, and a loaded machine may pause the client.
   test::ChildProcess server(
       {RP_HWSERVER_PATH, "-name", name, "-rate", "500", "-board", "puma560", "-watchdog", "5000"});
-  const auto line = server.readLine(10000);
+  const auto line = server.readLine(30000);
   ASSERT_TRUE(line.has_value());
   EXPECT_NE(line->find("6 AO, 6 encoders"), std::string::npos) << *line;
   HwServerIoBoard arm(name, 1000);

@@ -76,7 +76,7 @@ class Watchdog : public ::testing::Test {
   std::unique_ptr<test::ChildProcess> startClient(const char* mode) {
     auto client = std::make_unique<test::ChildProcess>(
         std::vector<std::string>{RP_HWSERVER_CLIENT_PATH, server_.name(), std::to_string(kVolts), mode});
-    const auto line = client->readLine(10000);
+    const auto line = client->readLine(30000);
     double silenceMs = 0;
     const int pid = server_.lastWatchdogTrip(silenceMs);
     EXPECT_EQ(line.value_or("(nothing)"), "ready")
@@ -119,7 +119,7 @@ TEST_F(Watchdog, StoppedClientIsCutOffAndItsWritesAreRefusedWhenItWakes) {
   expectOutputsGoOff("SIGSTOP");
   EXPECT_EQ(server_.watchdogTrips(), 1u);
   client->signal(SIGCONT);  // it wakes and writes enable 1 and its volts again
-  const auto line = client->readLine(10000);
+  const auto line = client->readLine(30000);
   ASSERT_TRUE(line.has_value());
   EXPECT_TRUE(contains(*line, "refused: hardware server '" + server_.name() + "' switched this client's outputs off"))
       << *line;
@@ -230,11 +230,11 @@ TEST_F(BackgroundHeartbeat, IdleClientKeepsItsOutputsWhileItsProcessRuns) {
 TEST(RpHwServer, WatchdogSwitchesOffThePumaAmplifiersAndLogsOnce) {
   const std::string name = uniqueName("puma");
   test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-board", "puma560", "-watchdog", "1000"}, true);
-  const auto line = server.readLine(10000);
+  const auto line = server.readLine(30000);
   ASSERT_TRUE(line.has_value());
   EXPECT_TRUE(contains(*line, "client watchdog 1000 ms")) << *line;
   test::ChildProcess client({RP_HWSERVER_CLIENT_PATH, name, "1.5", "loop"});
-  ASSERT_EQ(client.readLine(10000).value_or("(nothing)"), "ready");
+  ASSERT_EQ(client.readLine(30000).value_or("(nothing)"), "ready");
   HwServerIoBoard monitor(name, 2000);
   bool on = false;
   ASSERT_EQ(monitor.readAppliedDigitalOutput(0, on), IoStatus::kOk);
@@ -249,7 +249,7 @@ TEST(RpHwServer, WatchdogSwitchesOffThePumaAmplifiersAndLogsOnce) {
     return all;
   };
   EXPECT_GE(waitFor(off), 0.0) << "amplifier enable and DACs off";
-  const auto log = server.readLine(10000);
+  const auto log = server.readLine(30000);
   ASSERT_TRUE(log.has_value());
   EXPECT_TRUE(contains(*log, "rp-hwserver: client (pid " + std::to_string(client.pid()) + ") silent for")) << *log;
   EXPECT_TRUE(contains(*log, "its outputs switched off (watchdog 1000 ms)")) << *log;
@@ -265,7 +265,7 @@ TEST(RpHwServer, TheDefaultWatchdogIs50Ms) {
   EXPECT_EQ(HwServer(board, "x", 100.0).watchdogMs(), 50.0);
   const std::string name = uniqueName("default");
   test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-board", "simulated"});
-  const auto line = server.readLine(10000);
+  const auto line = server.readLine(30000);
   ASSERT_TRUE(line.has_value());
   EXPECT_TRUE(contains(*line, "client watchdog 50 ms")) << *line;
   HwServerIoBoard client(name, 2000);

@@ -129,7 +129,7 @@ TEST(RpHwServer, ServesASimulatedBoardAndDetectsItsDeath) {
   const std::string name = uniqueName("child");
   test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "200", "-board", "simulated", "-loopback",
                               "-watchdog", "5000"});
-  const auto line = server.readLine(10000);
+  const auto line = server.readLine(30000);
   ASSERT_TRUE(line.has_value());
   EXPECT_TRUE(contains(*line, "rp-hwserver: serving " + name)) << *line;
   HwServerIoBoard client(name, 1000);  // stale after 1 s without a cycle
@@ -151,7 +151,7 @@ TEST(RpHwServer, ServesASimulatedBoardAndDetectsItsDeath) {
   EXPECT_TRUE(contains(client.lastError(), "is not responding")) << client.lastError();
   // A new server of the same name replaces the dead one's segment.
   test::ChildProcess again({RP_HWSERVER_PATH, "-name", name, "-board", "simulated"});
-  const auto line2 = again.readLine(10000);
+  const auto line2 = again.readLine(30000);
   ASSERT_TRUE(line2.has_value());
   again.signal(SIGTERM);
   EXPECT_EQ(again.wait(5000), 0);
@@ -165,7 +165,7 @@ TEST(RpHwServer, DrivesModbusCoilsAndReportsTheBoardFailing) {
   test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "100", "-board", "modbus", "-port",
                              std::to_string(device.port()), "-timeout", "100", "-watchdog", "5000", "-coils", "4,5",
                              "-discreteInputs", "0,1"});
-  const auto line = server.readLine(10000);
+  const auto line = server.readLine(30000);
   ASSERT_TRUE(line.has_value());
   EXPECT_TRUE(contains(*line, "2 DI, 2 DO")) << *line;
   HwServerIoBoard client(name, 1000);

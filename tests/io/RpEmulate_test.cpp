@@ -15,7 +15,7 @@ int portOf(const std::string& line) { return std::stoi(line.substr(line.rfind(':
 
 TEST(RpEmulate, ModbusPrintsItsPortAndCoilChanges) {
   test::ChildProcess emulator({RP_EMULATE_PATH, "modbus", "-duration", "20"});
-  const auto line = emulator.readLine(10000);
+  const auto line = emulator.readLine(30000);
   ASSERT_TRUE(line.has_value());
   ASSERT_EQ(line->rfind("modbus 127.0.0.1:", 0), 0u) << *line;
   ModbusIoBoard::Config config;
@@ -31,7 +31,7 @@ TEST(RpEmulate, ModbusPrintsItsPortAndCoilChanges) {
 
 TEST(RpEmulate, BarrettHandAnswersOnItsPseudoTerminal) {
   test::ChildProcess emulator({RP_EMULATE_PATH, "barretthand", "-duration", "20"});
-  const auto line = emulator.readLine(10000);
+  const auto line = emulator.readLine(30000);
   ASSERT_TRUE(line.has_value());
   ASSERT_EQ(line->rfind("barretthand /dev/", 0), 0u) << *line;
   BarrettHandSerial hand({.port = line->substr(12), .timeoutMs = 1000, .motionTimeoutMs = 2000});
@@ -45,7 +45,7 @@ TEST(RpEmulate, BarrettHandAnswersOnItsPseudoTerminal) {
 TEST(RpEmulate, NetFtStreamsTheGivenWrench) {
   test::ChildProcess emulator({RP_EMULATE_PATH, "netft", "-wrench", "1", "-2", "3", "0.1", "0.2", "-0.3",
                                "-duration", "20"});
-  const auto line = emulator.readLine(10000);
+  const auto line = emulator.readLine(30000);
   ASSERT_TRUE(line.has_value());
   ASSERT_EQ(line->rfind("netft 127.0.0.1:", 0), 0u) << *line;
   NetFtClient sensor({.address = "127.0.0.1", .port = portOf(*line)});

@@ -101,7 +101,7 @@ class HardwareExitPath : public ::testing::Test {
     std::ofstream(dir_ / "rp.cfg") << "[puma]\nclass Puma560\nsimulationMode off\nhwserver " << name_ << "\n";
     server_ = std::make_unique<test::ChildProcess>(
         std::vector<std::string>{RP_HWSERVER_PATH, "-name", name_, "-rate", "1000", "-board", "puma560", "-watchdog", "1000"});
-    ASSERT_TRUE(server_->readLine(10000).has_value()) << "the server did not start";
+    ASSERT_TRUE(server_->readLine(30000).has_value()) << "the server did not start";
     monitor_ = std::make_unique<HwServerIoBoard>(name_);
   }
   void TearDown() override {

@@ -46,7 +46,7 @@ test::ChildProcess startServer(const std::string& prefix) {
 
 TEST(HardwareManipulator, PumaBehindAHardwareServerHoldsMovesAndShutsDownWhenTheServerDies) {
   test::ChildProcess server = startServer("test-arm");
-  ASSERT_TRUE(server.readLine(10000).has_value()) << "the server did not start";
+  ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
   {
     Puma560 puma("leader");
     ASSERT_TRUE(puma.usesHardware());
@@ -97,7 +97,7 @@ TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
   // divided by one period (1 ms) read as 50 rad/s and tripped the 2 rad/s velocity limit. The
   // velocity is taken over the time that really passed.
   test::ChildProcess server = startServer("test-stall");
-  ASSERT_TRUE(server.readLine(10000).has_value()) << "the server did not start";
+  ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
   {
     Puma560 puma("leader");
     StallOnce stall(puma.getDefaultPositionControl());

@@ -159,7 +159,7 @@ TEST(PoseAndModeHardware, ASimulatedArmSwitchesToTheHardwareAndBackLeavingItsOut
   RoboticPlatform::useRealClock();
   ObjectManager::resetShutdown();
   test::ChildProcess server({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
-  ASSERT_TRUE(server.readLine(10000).has_value()) << "the server did not start";
+  ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
   HwServerIoBoard monitor(name);
   auto amplifiersOn = [&] {
     bool enable = false;

@@ -193,6 +193,8 @@ def test_urdf_models_from_a_file_or_text_and_their_errors(tmp_path):
     path.write_text(urdf)
     from_file, from_text = rp.UrdfModel(str(path)), rp.UrdfModel(urdf)
     assert from_file.dof == from_text.dof == 2
+    assert from_file.joint_names == ["j1", "j2"] and from_file.link_names == ["l1", "l2"]
+    assert rp.Puma560Model().joint_names == [f"joint{i}" for i in range(1, 7)]
     q = np.array([0.3, -0.4])
     np.testing.assert_allclose(from_file.fk(q), from_text.fk(q), atol=1e-15)
     # Planar two-link arm: the tip of link 2's frame is at 0.2 (cos q1) ...
