@@ -92,7 +92,7 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   }
   const int n = model_->getNumberOfJoints();
   data_ = std::make_unique<ManipulatorData>(*model_);
-  sim_ = std::make_unique<ManipulatorSimulation>(*model_);
+  sim_ = makeSimulation(*model_, configSection());  // the plant, with rp.cfg's deviations
   wrench_ = std::make_unique<WrenchBox>();
   for (JointVector* v : {&q_, &qd_, &tau_, &gravity_, &hold_}) v->setZero(n);
   for (JointVector* v : {&setpoint_.position, &setpoint_.velocity, &setpoint_.acceleration}) v->setZero(n);
@@ -346,6 +346,7 @@ void DefaultManipulator::declareSettings(SettingSchema& schema) {
   Manipulator::declareSettings(schema);
   schema.addWord("hwserver", "name of the hardware server the arm is wired to");
   schema.addNumbers("countsPerRadian", 1, "counts/rad", "encoder counts per joint radian");
+  ManipulatorSimulation::declareSettings(schema);
 }
 
 bool DefaultManipulator::readHardware(double elapsed) {
