@@ -476,15 +476,22 @@ TEST(SimulationPlant, HeavierLinksTrackWorseUnderTheNominalController) {
 using SimulationPlantArm = test::SimulatedArmTest;
 TEST_F(SimulationPlantArm, DefaultManipulatorTakesItsPlantFromRpCfg) {
   RoboticPlatform::setConfiguration(Configuration::parse(
-      "[pumaSimulated]\nclass Puma560\nsimMassScale 1.1\nsimInitialPosition 0 30 -60 0 10 0\n", "rp.cfg"));
+      "[pumaSimulated]\nclass Puma560\nsimMassScale 1.1\nsimInitialPosition 0 30 -60 0 10 0\n"
+      "simCountsPerRadian 1000\n", "rp.cfg"));
   Puma560 arm("pumaSimulated");
   const Puma560Model fresh;
   for (int i = 0; i < 6; ++i) EXPECT_EQ(arm.getModel().getLink(i).mass, fresh.getLink(i).mass);
   const double deg = std::acos(-1.0) / 180;
+  // Where rp.cfg puts it, as 1000-count-per-radian encoders read it.
   const JointVector q = arm.getJointPosition();
-  EXPECT_NEAR(q(1), 30 * deg, 1e-12);
-  EXPECT_NEAR(q(2), -60 * deg, 1e-12);
-  EXPECT_NEAR(q(4), 10 * deg, 1e-12);
+  EXPECT_EQ(q(1), std::floor(30 * deg * 1000) / 1000);
+  EXPECT_EQ(q(2), std::floor(-60 * deg * 1000) / 1000);
+  EXPECT_EQ(q(4), std::floor(10 * deg * 1000) / 1000);
+  EXPECT_NE(q(1), 30 * deg);
+  // Running, the readings stay on the encoder's grid.
+  ASSERT_TRUE(arm.waitForCycles(50));
+  const JointVector later = arm.getJointPosition();
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(std::round(later(i) * 1000), later(i) * 1000, 1e-6) << "joint " << i + 1;
 }
 
 // ---- Real time ---------------------------------------------------------------------------------
