@@ -438,8 +438,17 @@ std::unique_ptr<ManipulatorSimulation> makeSimulation(const ManipulatorModel& no
   if (section->has("simPayload")) d.payload = section->getNumbers("simPayload").at(0);
   d.friction = onOff("simFriction");
   d.motorInertia = onOff("simMotorInertia");
-  for (const char* name : {"simMassScale", "simInertiaScale", "simFrictionScale", "simPayload"})
-    if (section->has(name)) check(name, [&] { (void)buildPlant(nominal, d); });
+  // Each deviation alone, so that an error names the line of the setting at fault.
+  for (const char* name : {"simMassScale", "simInertiaScale", "simFrictionScale", "simPayload"}) {
+    if (!section->has(name)) continue;
+    PlantDeviations one;
+    const std::string setting = name;
+    if (setting == "simMassScale") one.massScale = d.massScale;
+    if (setting == "simInertiaScale") one.inertiaScale = d.inertiaScale;
+    if (setting == "simFrictionScale") one.frictionScale = d.frictionScale;
+    if (setting == "simPayload") one.payload = d.payload;
+    check(name, [&] { (void)buildPlant(nominal, one); });
+  }
   const bool deviates = d.massScale.size() > 0 || d.inertiaScale.size() > 0 || d.frictionScale.size() > 0 ||
                         d.payload > 0 || !d.friction || !d.motorInertia;
   auto sim = deviates ? std::make_unique<ManipulatorSimulation>(nominal, d) : std::make_unique<ManipulatorSimulation>(nominal);
@@ -449,9 +458,8 @@ std::unique_ptr<ManipulatorSimulation> makeSimulation(const ManipulatorModel& no
   const JointVector counts = joints("simCountsPerRadian", false);
   int delay = 0;
   if (section->has("simSensorDelay")) delay = static_cast<int>(section->getNumbers("simSensorDelay").at(0));
-  check(section->has("simSensorDelay") ? "simSensorDelay" : "simCountsPerRadian", [&] {
-    if (counts.size() > 0 || delay > 0) sim->setSensor(counts, delay);
-  });
+  if (counts.size() > 0) check("simCountsPerRadian", [&] { sim->setSensor(counts, 0); });
+  if (delay != 0) check("simSensorDelay", [&] { sim->setSensor(counts, delay); });
 
   // Initial state: revolute joints in degrees, prismatic ones in millimetres.
   JointVector q = joints("simInitialPosition", true), qd = joints("simInitialVelocity", true);

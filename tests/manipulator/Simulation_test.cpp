@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <memory>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "AllocationCounter.hpp"
@@ -422,6 +424,23 @@ TEST(SimulationPlant, BadSettingsAreConfigErrorsWithTheLine) {
   expectError("[puma]\nclass Puma560\nsimSensorDelay 100\n", "rp.cfg:3:");
   expectError("[puma]\nclass Puma560\nintegrator midpoint\n", "rp.cfg:3:");
   expectError("[puma]\nclass Puma560\nsimCountsPerRadian 0\n", "rp.cfg:3:");
+  // Unchecked by the schema (a configuration read without the class checks), makeSimulation's
+  // own checks still name the line of the setting at fault.
+  Configuration::Options unchecked;
+  unchecked.checkClasses = false;
+  unchecked.loadPlugins = false;
+  for (const auto& [text, where] : std::vector<std::pair<std::string, std::string>>{
+           {"[puma]\nclass Puma560\nsimMassScale 1.1\nsimPayload -3\n", "rp.cfg:4:"},
+           {"[puma]\nclass Puma560\nsimFrictionScale -1\nsimPayload 3\n", "rp.cfg:3:"},
+           {"[puma]\nclass Puma560\nsimCountsPerRadian 100\nsimSensorDelay 17\n", "rp.cfg:4:"}}) {
+    try {
+      const Configuration config = Configuration::parse(text, "rp.cfg", unchecked);
+      (void)makeSimulation(nominal, &section(config));
+      ADD_FAILURE() << "no error for:\n" << text;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+    }
+  }
 }
 
 // PD control with inverse-dynamics feed-forward (with friction) from the nominal model
