@@ -4,16 +4,22 @@
 // of every arm, the RK4 integrator's accuracy against a fine-step ground truth, plant deviations
 // and simulated sensors from rp.cfg, and no allocation while stepping.
 #include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <random>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 #include "AllocationCounter.hpp"
+#include "MjcfArm.hpp"
 #include "SimulatedArmTest.hpp"
 #include "rp/RoboticPlatform.hpp"
 #include "rp/manipulator/ManipulatorSimulation.hpp"
@@ -206,6 +212,50 @@ TEST(SimulationFriction, PumaShoulderFreeFallMatchesTheReference) {
         EXPECT_NEAR(got(i), expected(i), 0.02 * std::abs(expected(i) - q(i)) + 1e-4) << "joint " << i + 1;
       }
     }
+  }
+}
+
+// The same free fall in MuJoCo (Debian's libmujoco-dev), an independent simulator: the arm as MJCF
+// (same DH frames, masses, inertias, armature and damping), each joint's dry friction as MuJoCo's
+// frictionloss (two-sided in MuJoCo: the shoulder gets the side it slides on, the others the
+// smaller side, which still holds them), RK4 at 0.1 ms. MuJoCo's friction is a soft constraint
+// (a joint that sticks creeps a little), so the shoulder's fall agrees to about 1 %.
+TEST(SimulationFriction, PumaShoulderFreeFallAgreesWithMuJoCo) {
+  Puma560Model model;
+  JointVector q = model.getHomePosition();
+  q(1) = 0;
+  q(2) = 0.3;
+  std::vector<double> friction;
+  for (int i = 0; i < 6; ++i) {
+    const LinkParameters& l = model.getLink(i);
+    friction.push_back(i == 1 ? coulombNeg(l) : std::min(coulombPos(l), coulombNeg(l)));
+  }
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("rp_simulation_test_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(file) << test::mjcf(model, true, friction);
+  char error[1000] = "";
+  mjModel* m = mj_loadXML(file.c_str(), nullptr, error, sizeof error);
+  std::filesystem::remove(file);
+  ASSERT_NE(m, nullptr) << error;
+  m->opt.integrator = mjINT_RK4;
+  m->opt.timestep = 1e-4;
+  mjData* d = mj_makeData(m);
+  for (int i = 0; i < 6; ++i) d->qpos[i] = q(i);
+  for (int k = 0; k < 3000; ++k) mj_step(m, d);
+  const double mujocoFall = d->qpos[1] - q(1);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+
+  const JointVector zero = JointVector::Zero(6);
+  for (SimulationIntegrator integrator : {SimulationIntegrator::Euler, SimulationIntegrator::RK4}) {
+    ManipulatorSimulation sim(model);
+    sim.setIntegrator(integrator);
+    sim.setState(q, zero);
+    for (int k = 0; k < 300; ++k) sim.step(zero, 1e-3);
+    const double fall = sim.getTruePosition()(1) - q(1);
+    std::printf("  %s: shoulder fell %.2f mrad in 0.3 s, MuJoCo %.2f mrad\n",
+                integrator == SimulationIntegrator::RK4 ? "rk4" : "euler", 1e3 * fall, 1e3 * mujocoFall);
+    EXPECT_NEAR(fall, mujocoFall, 0.015 * std::abs(mujocoFall));
   }
 }
 
