@@ -1,10 +1,13 @@
 // One simulated servo cycle of a Puma 560 and a WAM 7: the control law (PD with gravity
-// compensation), forward dynamics with motor inertia and viscous friction, and one semi-implicit
-// Euler step of 1 ms, through ManipulatorSimulation; next to MuJoCo stepping the same arm, which
+// compensation), forward dynamics with motor inertia and viscous friction, and one
+// step of 1 ms, through ManipulatorSimulation (its default integrator; ServoCycle_rpEuler and
+// ServoCycle_rpRK4 take each integrator, with counter error_2s_rad: the largest joint error after
+// 2 s of free motion against RK4 at 10 us; Part_rpStep* time the step alone), next to MuJoCo
+// stepping the same arm, which
 // this program writes in MJCF from the same model (same DH frames, masses, centres of mass,
 // inertias, armature G^2 Jm, viscous damping B G^2; no contacts, timestep 1 ms, integrator Euler
 // (MuJoCo's is semi-implicit with implicit damping)). Our step also applies the model's Coulomb
-// friction as a velocity impulse (a few nanoseconds); MuJoCo gets none. The same control torques
+// friction as a constraint through the mass matrix; MuJoCo gets none. The same control torques
 // are computed for both with our gravity routine (so its cost is in both cycles). A second MuJoCo
 // variant has no damping attribute and gets the viscous torque as an applied force, so that both
 // sides take the same semi-implicit Euler step with explicit damping. Part_* entries time the
@@ -17,55 +20,23 @@
 
 #include <mujoco/mujoco.h>
 
+#include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "MjcfArm.hpp"
 #include "rp/manipulator/ManipulatorSimulation.hpp"
 #include "rp/model/Model.hpp"
 
 namespace {
 
 using namespace rp;
-
-// MJCF for a standard-DH model: body k sits at frame k-1 and turns about its z axis; link k's
-// inertia lives in frame k = Rz(q_k) M_k with M_k = Tz(d) Tx(a) Rx(alpha), so it is given at
-// M_k * com with the rotated inertia tensor, and body k+1 is placed at M_k.
-// With `damping` false the joints get no damping attribute (the benchmark then applies the viscous
-// friction itself, explicitly, as ManipulatorSimulation does).
-std::string mjcf(const ManipulatorModel& model, bool damping = true) {
-  std::ostringstream x;
-  x.precision(17);
-  // balanceinertia: the Puma's link 1 (Ixx = Izz = 0, Iyy = 0.35) breaks MuJoCo's triangle
-  // inequality check; MuJoCo then adjusts that inertia (timing is unaffected).
-  x << "<mujoco model=\"" << model.getName() << "\">\n<compiler balanceinertia=\"true\"/>\n"
-    << "<option timestep=\"0.001\" integrator=\"Euler\" gravity=\"0 0 -9.81\"><flag contact=\"disable\"/></option>\n"
-    << "<worldbody>\n";
-  Transform parent = Transform::unit();  // pose of body k's frame in body k-1's frame
-  const int n = model.getNumberOfJoints();
-  for (int k = 0; k < n; ++k) {
-    const LinkParameters& l = model.getLink(k);
-    const Transform M = translation(0, 0, l.d) * translation(l.a, 0, 0) * xRotation(l.alpha);
-    const Eigen::Quaterniond qp(Eigen::Matrix3d(parent.topLeftCorner<3, 3>()));
-    x << "<body name=\"link" << k + 1 << "\" pos=\"" << parent(0, 3) << " " << parent(1, 3) << " " << parent(2, 3)
-      << "\" quat=\"" << qp.w() << " " << qp.x() << " " << qp.y() << " " << qp.z() << "\">\n";
-    const double G = l.gearRatio;
-    x << "<joint name=\"j" << k + 1 << "\" type=\"hinge\" axis=\"0 0 1\" armature=\"" << G * G * l.motorInertia
-      << "\" damping=\"" << (damping ? l.viscousFriction * G * G : 0.0) << "\"/>\n";
-    const Eigen::Vector3d c = M.topLeftCorner<3, 3>() * Eigen::Vector3d(l.com) + M.topRightCorner<3, 1>();
-    const Eigen::Matrix3d I = M.topLeftCorner<3, 3>() * Eigen::Matrix3d(l.inertia) * M.topLeftCorner<3, 3>().transpose();
-    const double mass = l.mass > 0 ? l.mass : 1e-6;  // MuJoCo needs mass on a moving body
-    x << "<inertial pos=\"" << c(0) << " " << c(1) << " " << c(2) << "\" mass=\"" << mass << "\" fullinertia=\""
-      << I(0, 0) + 1e-9 << " " << I(1, 1) + 1e-9 << " " << I(2, 2) + 1e-9 << " " << I(0, 1) << " " << I(0, 2) << " "
-      << I(1, 2) << "\"/>\n";
-    parent = M;
-  }
-  for (int k = 0; k < n; ++k) x << "</body>\n";
-  x << "</worldbody>\n</mujoco>\n";
-  return x.str();
-}
+using rp::test::mjcf;
 
 // A MuJoCo model and data loaded from the MJCF the benchmark writes.
 struct MuJoCoArm {
@@ -134,8 +105,70 @@ Arm& arm(const benchmark::State& s) {
   return s.range(0) == 6 ? puma : wam;
 }
 
+// Largest joint error [rad] after 2 s of free motion (no gravity, no friction: the arm coasts from
+// the middle of its ranges, coupled through M and C) of a 1 ms step of `integrator`, against the
+// same dynamics by RK4 at 10 us.
+double freeMotionError(const ManipulatorModel& arm, SimulationIntegrator integrator) {
+  const int n = arm.getNumberOfJoints();
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < n; ++i) {
+    LinkParameters l = arm.getLink(i);
+    l.viscousFriction = l.coulombFrictionPositive = l.coulombFrictionNegative = 0;
+    links.push_back(l);
+  }
+  const ManipulatorModel model(arm.getName(), links, arm.getBaseTransform(), arm.getToolTransform(), Vector<3>());
+  JointVector q0(n), v0(n);
+  for (int i = 0; i < n; ++i) {
+    q0(i) = 0.5 * (model.getPositionMin()(i) + model.getPositionMax()(i));
+    v0(i) = i % 2 ? -0.3 : 0.4;
+  }
+  auto run = [&](SimulationIntegrator which, double h) {
+    ManipulatorSimulation sim(model);
+    sim.setIntegrator(which);
+    sim.setState(q0, v0);
+    const JointVector zero = JointVector::Zero(n);
+    const long steps = std::lround(2.0 / h);
+    for (long k = 0; k < steps; ++k) sim.step(zero, h);
+    return sim.getTruePosition();
+  };
+  static std::map<std::string, JointVector> reference;
+  if (reference.count(model.getName()) == 0) reference[model.getName()] = run(SimulationIntegrator::RK4, 1e-5);
+  return (run(integrator, 1e-3) - reference[model.getName()]).cwiseAbs().maxCoeff();
+}
+
+// One servo cycle with the given integrator; counters: the free-motion accuracy above.
+void servoCycle(benchmark::State& s, SimulationIntegrator integrator) {
+  Arm& a = arm(s);
+  a.sim->setIntegrator(integrator);
+  a.sim->setState(a.model->getHomePosition(), JointVector(a.model->getNumberOfJoints()));
+  for (auto _ : s) {
+    a.control(a.sim->getPosition(), a.sim->getVelocity());
+    a.sim->step(a.tau, 1e-3);
+    benchmark::DoNotOptimize(a.sim->getPosition().data());
+  }
+  s.counters["error_2s_rad"] = freeMotionError(*a.model, integrator);
+  s.counters["arms_per_core"] = benchmark::Counter(1e-3, benchmark::Counter::kIsIterationInvariantRate);
+}
+void ServoCycle_rpEuler(benchmark::State& s) { servoCycle(s, SimulationIntegrator::Euler); }
+void ServoCycle_rpRK4(benchmark::State& s) { servoCycle(s, SimulationIntegrator::RK4); }
+
+// The simulation step alone (no control law), each integrator, next to Part_MuJoCoStep.
+void stepOnly(benchmark::State& s, SimulationIntegrator integrator) {
+  Arm& a = arm(s);
+  a.sim->setIntegrator(integrator);
+  a.sim->setState(a.target, JointVector(a.model->getNumberOfJoints()));
+  a.control(a.target, JointVector(a.model->getNumberOfJoints()));
+  for (auto _ : s) {
+    a.sim->step(a.tau, 1e-3);
+    benchmark::DoNotOptimize(a.sim->getPosition().data());
+  }
+}
+void Part_rpStepEuler(benchmark::State& s) { stepOnly(s, SimulationIntegrator::Euler); }
+void Part_rpStepRK4(benchmark::State& s) { stepOnly(s, SimulationIntegrator::RK4); }
+
 void ServoCycle_rp(benchmark::State& s) {
   Arm& a = arm(s);
+  a.sim->setIntegrator(ManipulatorSimulation(*a.model).getIntegrator());  // the default
   a.sim->setState(a.model->getHomePosition(), JointVector(a.model->getNumberOfJoints()));
   for (auto _ : s) {
     a.control(a.sim->getPosition(), a.sim->getVelocity());
@@ -206,6 +239,10 @@ void Part_MuJoCoStep(benchmark::State& s) {
 }
 
 BENCHMARK(ServoCycle_rp)->Arg(6)->Arg(7);
+BENCHMARK(ServoCycle_rpEuler)->Arg(6)->Arg(7);
+BENCHMARK(ServoCycle_rpRK4)->Arg(6)->Arg(7);
+BENCHMARK(Part_rpStepEuler)->Arg(6)->Arg(7);
+BENCHMARK(Part_rpStepRK4)->Arg(6)->Arg(7);
 BENCHMARK(ServoCycle_MuJoCo)->Arg(6)->Arg(7);
 BENCHMARK(ServoCycle_MuJoCoExplicitDamping)->Arg(6)->Arg(7);
 BENCHMARK(Part_rpGravityTorque)->Arg(6)->Arg(7);

@@ -104,7 +104,7 @@ std::unique_ptr<DefaultManipulator::Setup> DefaultManipulator::makeSetup(bool si
     }
   }
   setup->data = std::make_unique<ManipulatorData>(*setup->model);
-  setup->sim = std::make_unique<ManipulatorSimulation>(*setup->model);
+  setup->sim = makeSimulation(*setup->model, configSection());  // the plant, with rp.cfg's deviations
   return setup;
 }
 
@@ -472,6 +472,7 @@ void DefaultManipulator::declareSettings(SettingSchema& schema) {
   Manipulator::declareSettings(schema);
   schema.addWord("hwserver", "name of the hardware server the arm is wired to");
   schema.addNumbers("countsPerRadian", 1, "counts/rad", "encoder counts per joint radian");
+  ManipulatorSimulation::declareSettings(schema);
 }
 
 bool DefaultManipulator::readHardware(double elapsed) {

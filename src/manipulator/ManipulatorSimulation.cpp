@@ -5,28 +5,149 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
+
+#include "rp/core/Configuration.hpp"
 
 namespace rp {
 
-ManipulatorSimulation::ManipulatorSimulation(const ManipulatorModel& model) : model_(model), data_(model) {
-  const int n = model.getNumberOfJoints();
-  q_ = model.getHomePosition();
-  for (JointVector* v : {&qd_, &qdd_, &tauTotal_, &tauExt_, &coulombPos_, &coulombNeg_}) v->setZero(n);
-  brakeTorque_ = model.getTorqueLimit();
-  for (int i = 0; i < n; ++i) {
-    const LinkParameters& l = model.getLink(i);
-    coulombPos_(i) = std::abs(l.gearRatio) * l.coulombFrictionPositive;
-    coulombNeg_(i) = std::abs(l.gearRatio) * l.coulombFrictionNegative;
+namespace {
+
+constexpr int kMaxFrictionSweeps = 200;  // coordinate-descent sweeps of the friction problem
+constexpr double kFrictionTolerance = 1e-13;  // [rad/s] largest change in the last sweep
+constexpr int kMaxStopSubsteps = 100;
+
+// A model that keeps another's home position (ManipulatorModel::setHomePosition is protected).
+class PlantModel : public ManipulatorModel {
+ public:
+  PlantModel(const ManipulatorModel& nominal, std::vector<LinkParameters> links)
+      : ManipulatorModel(nominal.getName(), std::move(links), nominal.getBaseTransform(), nominal.getToolTransform(),
+                         nominal.getGravity(), nominal.getConvention()) {
+    setHomePosition(nominal.getHomePosition());
   }
+};
+
+// `v` with n entries (an empty one: all `fallback`), each checked.
+JointVector perJoint(const JointVector& v, int n, double fallback, bool zeroAllowed, const char* what) {
+  if (v.size() == 0) return JointVector::Constant(n, fallback);
+  if (v.size() != n)
+    throw std::invalid_argument(std::string("ManipulatorSimulation: ") + what + ": " + std::to_string(v.size()) +
+                                " values for " + std::to_string(n) + " joints");
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(v(i)) || v(i) < 0 || (!zeroAllowed && v(i) == 0))
+      throw std::invalid_argument(std::string("ManipulatorSimulation: ") + what + " of joint " + std::to_string(i + 1) +
+                                  (zeroAllowed ? " must be finite and not negative" : " must be positive and finite"));
+  return v;
+}
+
+std::unique_ptr<const ManipulatorModel> buildPlant(const ManipulatorModel& nominal, const PlantDeviations& d) {
+  const int n = nominal.getNumberOfJoints();
+  const JointVector mass = perJoint(d.massScale, n, 1.0, false, "mass scale");
+  const JointVector inertia = perJoint(d.inertiaScale, n, 1.0, false, "inertia scale");
+  const JointVector friction = perJoint(d.frictionScale, n, 1.0, true, "friction scale");
+  if (!std::isfinite(d.payload) || d.payload < 0)
+    throw std::invalid_argument("ManipulatorSimulation: the payload must be finite and not negative");
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < n; ++i) {
+    LinkParameters l = nominal.getLink(i);
+    l.mass *= mass(i);
+    l.inertia = Matrix<3, 3>(Eigen::Matrix3d(l.inertia) * inertia(i));
+    const double f = d.friction ? friction(i) : 0.0;
+    l.viscousFriction *= f;
+    l.coulombFrictionPositive *= f;
+    l.coulombFrictionNegative *= f;
+    if (!d.motorInertia) l.motorInertia = 0;
+    links.push_back(l);
+  }
+  if (d.payload > 0) {
+    // A point mass at the tool frame's origin, in the last link's frame: the link's mass, centre
+    // of mass and inertia about it combine with it (parallel-axis theorem).
+    LinkParameters& l = links.back();
+    const Eigen::Vector3d p = nominal.getToolTransform().topRightCorner<3, 1>();
+    const Eigen::Vector3d c = l.com;
+    const double m = l.mass + d.payload;
+    const Eigen::Vector3d cNew = (l.mass * c + d.payload * p) / m;
+    auto shift = [](double mass, const Eigen::Vector3d& r) -> Eigen::Matrix3d {
+      return mass * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+    };
+    l.inertia = Matrix<3, 3>(Eigen::Matrix3d(l.inertia) + shift(l.mass, c - cNew) + shift(d.payload, p - cNew));
+    l.com = Vector<3>(cNew);
+    l.mass = m;
+  }
+  return std::make_unique<PlantModel>(nominal, std::move(links));
+}
+
+}  // namespace
+
+ManipulatorSimulation::ManipulatorSimulation(const ManipulatorModel& model) : model_(model), data_(model) { init(); }
+
+ManipulatorSimulation::ManipulatorSimulation(const ManipulatorModel& nominal, const PlantDeviations& deviations)
+    : own_(buildPlant(nominal, deviations)), model_(*own_), data_(*own_) {
+  init();
+}
+
+ManipulatorSimulation::~ManipulatorSimulation() = default;
+
+void ManipulatorSimulation::init() {
+  const int n = model_.getNumberOfJoints();
+  q_ = model_.getHomePosition();
+  for (JointVector* v : {&qd_, &qdd_, &tauTotal_, &tauExt_, &tauApplied_, &coulombPos_, &coulombNeg_, &viscous_, &diag_,
+                         &rhs_, &residual_, &upper_, &lower_, &q0_, &v0_, &kq_, &kv_, &sumQ_, &sumV_})
+    v->setZero(n);
+  A_.setZero(n, n);
+  L_.setZero(n, n);
+  brakeTorque_ = model_.getTorqueLimit();
+  for (int i = 0; i < n; ++i) {
+    const LinkParameters& l = model_.getLink(i);
+    coulombPos_(i) = std::abs(l.gearRatio * l.coulombFrictionPositive);
+    coulombNeg_(i) = std::abs(l.gearRatio * l.coulombFrictionNegative);
+    viscous_(i) = l.viscousFriction * l.gearRatio * l.gearRatio;
+  }
+  hasCoulomb_ = coulombPos_.maxCoeff() > 0 || coulombNeg_.maxCoeff() > 0;
   options_.gravity = true;
   options_.motorInertia = true;
-  options_.friction = false;  // viscous part added below; Coulomb as an impulse
+  options_.friction = false;  // viscous friction implicit (Euler) or explicit (RK4), Coulomb as a constraint
+  setState(q_, qd_);
 }
 
 void ManipulatorSimulation::setState(const JointVector& q, const JointVector& qd) {
   q_ = q;
   qd_ = qd;
   qdd_.setZero();
+  for (int k = 0; k <= kMaxSensorDelay; ++k) {
+    head_ = k;
+    recordReading();
+  }
+}
+
+void ManipulatorSimulation::setSensor(const JointVector& countsPerRadian, int delay) {
+  const int n = model_.getNumberOfJoints();
+  if (countsPerRadian.size() != 0) {
+    if (countsPerRadian.size() != n)
+      throw std::invalid_argument("ManipulatorSimulation::setSensor: " + std::to_string(countsPerRadian.size()) +
+                                  " resolutions for " + std::to_string(n) + " joints");
+    for (int i = 0; i < n; ++i)
+      if (!(countsPerRadian(i) > 0))
+        throw std::invalid_argument("ManipulatorSimulation::setSensor: joint " + std::to_string(i + 1) +
+                                    ": the encoder resolution must be positive");
+  }
+  if (delay < 0 || delay > kMaxSensorDelay)
+    throw std::invalid_argument("ManipulatorSimulation::setSensor: the delay " + std::to_string(delay) +
+                                " is not in 0.." + std::to_string(kMaxSensorDelay));
+  countsPerRadian_ = countsPerRadian;
+  delay_ = delay;
+  setState(q_, qd_);
+}
+
+void ManipulatorSimulation::recordReading() {
+  const auto k = static_cast<std::size_t>(head_);
+  readPosition_[k] = q_;
+  readVelocity_[k] = qd_;
+  // An encoder counts whole increments: the reading is the count below the position.
+  for (int i = 0; i < countsPerRadian_.size(); ++i)
+    if (std::isfinite(countsPerRadian_(i)))
+      readPosition_[k](i) = std::floor(q_(i) * countsPerRadian_(i)) / countsPerRadian_(i);
 }
 
 void ManipulatorSimulation::setBrakeTorque(const JointVector& torque) {
@@ -43,21 +164,35 @@ void ManipulatorSimulation::setBrakeTorque(const JointVector& torque) {
 void ManipulatorSimulation::step(const JointVector& tau, double dt) {
   const int n = model_.getNumberOfJoints();
   externalTorque();  // constant over the step
-  // Sub-steps while a joint is at a stop: the stop's stiffness k against the joint's inertia
-  // (at least its armature) gives the frequency to resolve.
-  bool atStop = false;
-  for (int i = 0; i < n; ++i) {
-    if (q_(i) < model_.getPositionMin()(i) || q_(i) > model_.getPositionMax()(i)) atStop = true;
-  }
+  // With the brakes on the amplifiers are off: no motor torque.
+  for (int i = 0; i < n; ++i)
+    tauApplied_(i) = (brakes_ ? 0.0 : std::clamp(tau(i), -model_.getTorqueLimit()(i), model_.getTorqueLimit()(i))) + tauExt_(i);
+  // Sub-steps while a joint is at a stop: the stop's stiffness against that joint's inertia gives
+  // the frequency to resolve (the implicit stop is stable without them; they keep it accurate).
   int substeps = 1;
+  bool atStop = false;
+  auto nearStop = [&](int i) {
+    const double lo = model_.getPositionMin()(i), hi = model_.getPositionMax()(i), next = q_(i) + dt * qd_(i);
+    return q_(i) < lo || q_(i) > hi || next < lo || next > hi;
+  };
+  for (int i = 0; i < n; ++i) atStop = atStop || nearStop(i);
   if (atStop) {
-    const double inertia = std::max(1e-3, model_.getArmatureInertia().minCoeff());
-    const double omega = std::sqrt(stopStiffness_ / inertia);
-    substeps = std::clamp(static_cast<int>(std::ceil(omega * dt / 0.2)), 1, 200);
+    const JointMatrix& M = massMatrix(model_, data_, q_, true);
+    for (int i = 0; i < n; ++i) {
+      if (!nearStop(i)) continue;
+      const double omega = std::sqrt(stopStiffness_ / M(i, i));
+      substeps = std::max(substeps, std::min(kMaxStopSubsteps, static_cast<int>(std::ceil(omega * dt / 0.5))));
+    }
   }
   lastSubsteps_ = substeps;
-  const double h = dt / substeps;
-  for (int s = 0; s < substeps; ++s) integrate(tau, h);
+  if (!atStop && integrator_ == SimulationIntegrator::RK4) {
+    rk4Step(dt);
+  } else {
+    const double h = dt / substeps;
+    for (int s = 0; s < substeps; ++s) eulerStep(h);
+  }
+  head_ = (head_ + 1) % (kMaxSensorDelay + 1);
+  recordReading();
 }
 
 void ManipulatorSimulation::setExternalLinkWrench(int link, const Vector<3>& point, const Vector<6>& wrench) {
@@ -101,37 +236,249 @@ void ManipulatorSimulation::externalTorque() {
   }
 }
 
-void ManipulatorSimulation::integrate(const JointVector& tau, double h) {
+void ManipulatorSimulation::eulerStep(double h) {
+  // Semi-implicit Euler with the viscous friction and the joint stops implicit in the velocity:
+  // M (v+ - v) = h (tau - bias - k (q + h v+ - limit) - (b + c) v+), that is
+  // (M + h diag(b + c + h k)) v+ = M (v + h qdd0) with qdd0 = M^-1 (tau - bias - k (q - limit)).
   const int n = model_.getNumberOfJoints();
-  const double stopDamping = 2.0 * std::sqrt(stopStiffness_ * 0.1);
+  const double k = stopStiffness_;
+  // A stop acts on the penetration at the end of the step, so it engages in the step in which the
+  // joint would cross its limit (q + h v beyond it): a joint never enters a stop by a whole step's
+  // travel unopposed (that would store spring energy it never had).
+  tauTotal_ = tauApplied_ - viscous_.cwiseProduct(qd_);
   for (int i = 0; i < n; ++i) {
-    const LinkParameters& l = model_.getLink(i);
-    // With the brakes on the amplifiers are off: no motor torque.
-    double t = brakes_ ? 0.0 : std::clamp(tau(i), -model_.getTorqueLimit()(i), model_.getTorqueLimit()(i));
-    t += tauExt_(i);
-    t -= l.viscousFriction * l.gearRatio * l.gearRatio * qd_(i);
-    if (q_(i) < l.positionMin) t += stopStiffness_ * (l.positionMin - q_(i)) - stopDamping * std::min(qd_(i), 0.0);
-    if (q_(i) > l.positionMax) t += stopStiffness_ * (l.positionMax - q_(i)) - stopDamping * std::max(qd_(i), 0.0);
-    tauTotal_(i) = t;
+    const double lo = model_.getPositionMin()(i), hi = model_.getPositionMax()(i), next = q_(i) + h * qd_(i);
+    engaged_[static_cast<std::size_t>(i)] = q_(i) < lo || q_(i) > hi || next < lo || next > hi;
+    if (!engaged_[static_cast<std::size_t>(i)]) continue;
+    tauTotal_(i) += k * ((q_(i) > hi || next > hi ? hi : lo) - q_(i));
   }
   forwardDynamics(model_, data_, q_, qd_, tauTotal_, options_);
-  qdd_ = data_.qdd;
+  const JointMatrix& M = data_.massMatrix;
   for (int i = 0; i < n; ++i) {
-    double v = qd_(i) + h * qdd_(i);
-    // Coulomb friction (and an engaged brake, which acts the same way with its braking torque):
-    // an impulse against the motion that stops the joint but never reverses it.
-    const double m = data_.massMatrix(i, i);
-    const double brake = brakes_ ? brakeTorque_(i) : 0.0;
-    const double friction = (v > 0 ? std::abs(coulombPos_(i)) : (v < 0 ? std::abs(coulombNeg_(i)) : 0.0)) + brake;
-    const double dv = h * friction / m;  // a magnitude
-    if (std::abs(v) <= dv) {
-      v = 0;
-    } else {
-      v -= std::copysign(dv, v);
-    }
-    qd_(i) = v;
-    q_(i) += h * v;
+    diag_(i) = viscous_(i);
+    // A stop critically damped for the joint's inertia at the stop.
+    if (engaged_[static_cast<std::size_t>(i)]) diag_(i) += 2.0 * std::sqrt(k * M(i, i)) + h * k;
   }
+  // qdd0 with the viscous torque at the start of the step (what getAcceleration() reports), so
+  // the right-hand side adds it back: M (v + h qdd0) + h b v.
+  qdd_ = data_.qdd;
+  v0_ = qd_ + h * qdd_;
+  rhs_.noalias() = M * v0_;
+  rhs_ += h * viscous_.cwiseProduct(qd_);
+  A_ = M;
+  for (int i = 0; i < n; ++i) A_(i, i) += h * diag_(i);
+  // v* = A^-1 rhs by Cholesky (A is positive definite); without implicit terms v* = v0 exactly.
+  if (diag_.cwiseAbs().maxCoeff() > 0) {
+    for (int j = 0; j < n; ++j) {
+      double d = A_(j, j);
+      for (int m = 0; m < j; ++m) d -= L_(j, m) * L_(j, m);
+      L_(j, j) = std::sqrt(d);
+      for (int i = j + 1; i < n; ++i) {
+        double s = A_(i, j);
+        for (int m = 0; m < j; ++m) s -= L_(i, m) * L_(j, m);
+        L_(i, j) = s / L_(j, j);
+      }
+    }
+    kv_ = rhs_;
+    for (int i = 0; i < n; ++i) {
+      for (int m = 0; m < i; ++m) kv_(i) -= L_(i, m) * kv_(m);
+      kv_(i) /= L_(i, i);
+    }
+    for (int i = n - 1; i >= 0; --i) {
+      for (int m = i + 1; m < n; ++m) kv_(i) -= L_(m, i) * kv_(m);
+      kv_(i) /= L_(i, i);
+    }
+  } else {
+    kv_ = v0_;
+  }
+  qd_ = kv_;
+  if (hasCoulomb_ || brakes_) solveFriction(h);
+  q_ += h * qd_;
+}
+
+void ManipulatorSimulation::rk4Step(double h) {
+  // The classical Runge-Kutta method on q' = v, v' = M^-1 (tau - bias - b v), the applied and
+  // external torques held over the step; then Coulomb friction and brakes as the same constraint
+  // as in the Euler step, taken over the step (the position moves by half the velocity change, as
+  // under a constant friction torque; a joint at rest that stays at rest does not move at all).
+  const int n = model_.getNumberOfJoints();
+  q0_ = q_;
+  v0_ = qd_;
+  sumQ_.setZero();
+  sumV_.setZero();
+  for (int s = 0; s < 4; ++s) {
+    tauTotal_ = tauApplied_ - viscous_.cwiseProduct(qd_);
+    forwardDynamics(model_, data_, q_, qd_, tauTotal_, options_);
+    kq_ = qd_;
+    kv_ = data_.qdd;
+    if (s == 0) qdd_ = kv_;
+    const double w = (s == 0 || s == 3) ? 1.0 : 2.0;
+    sumQ_ += w * kq_;
+    sumV_ += w * kv_;
+    if (s < 3) {
+      const double c = s < 2 ? 0.5 * h : h;
+      q_ = q0_ + c * kq_;
+      qd_ = v0_ + c * kv_;
+    }
+  }
+  q_ = q0_ + (h / 6.0) * sumQ_;
+  qd_ = v0_ + (h / 6.0) * sumV_;
+  if (hasCoulomb_ || brakes_) {
+    A_ = data_.massMatrix;  // at the last stage (q0 + h v3), the end of the step to first order
+    rhs_.noalias() = A_ * qd_;
+    kv_ = qd_;
+    solveFriction(h);
+    for (int i = 0; i < n; ++i) q_(i) = (v0_(i) == 0 && qd_(i) == 0) ? q0_(i) : q_(i) + 0.5 * h * (qd_(i) - kv_(i));
+  }
+}
+
+void ManipulatorSimulation::solveFriction(double h) {
+  // Minimise 1/2 v^T A v - rhs^T v + h sum_i f_i(v_i), f_i(v) = F+ v (v > 0), -F- v (v < 0), by
+  // exact coordinate descent from the frictionless solution in qd_: each coordinate's minimiser is
+  // a soft threshold. The objective is strictly convex, so the sweeps converge to its minimiser;
+  // a joint whose holding torque is within its friction comes out exactly at rest.
+  const int n = model_.getNumberOfJoints();
+  for (int i = 0; i < n; ++i) {
+    const double brake = brakes_ ? brakeTorque_(i) : 0.0;
+    upper_(i) = h * (coulombPos_(i) + brake);
+    lower_(i) = h * (coulombNeg_(i) + brake);
+  }
+  residual_.noalias() = A_ * qd_;
+  residual_ -= rhs_;
+  for (int sweep = 0; sweep < kMaxFrictionSweeps; ++sweep) {
+    double change = 0;
+    for (int i = 0; i < n; ++i) {
+      const double a = A_(i, i);
+      const double p = a * qd_(i) - residual_(i);  // a times the coordinate's unconstrained minimiser
+      double x = 0;
+      if (p > upper_(i)) {
+        x = (p - upper_(i)) / a;
+      } else if (p < -lower_(i)) {
+        x = (p + lower_(i)) / a;
+      }
+      const double d = x - qd_(i);
+      if (d == 0) continue;
+      qd_(i) = x;
+      residual_ += A_.col(i) * d;
+      change = std::max(change, std::abs(d));
+    }
+    if (change <= kFrictionTolerance) break;
+  }
+}
+
+void ManipulatorSimulation::declareSettings(SettingSchema& schema) {
+  schema.addChoice("integrator", {"euler", "rk4"}, "integrator of the simulated arm (semi-implicit Euler or RK4)");
+  auto perJointNumbers = [&schema](const char* name, const char* unit, const char* description, double lo, double hi) {
+    SettingSpec spec;
+    spec.name = name;
+    spec.kind = SettingKind::Number;
+    spec.minValues = 1;
+    spec.maxValues = kMaxJoints;
+    spec.unit = unit;
+    spec.description = description;
+    spec.minValue = lo;
+    spec.maxValue = hi;
+    schema.add(spec);
+  };
+  perJointNumbers("simMassScale", "", "simulated plant: factor on the link masses (one for all links, or one per link)",
+                  0.1, 10);
+  perJointNumbers("simInertiaScale", "",
+                  "simulated plant: factor on the link inertias (one for all links, or one per link)", 0.1, 10);
+  perJointNumbers("simFrictionScale", "",
+                  "simulated plant: factor on the joint friction (one for all joints, or one per joint)", 0, 10);
+  schema.addNumbers("simPayload", 1, "kg", "simulated plant: point mass at the tool frame's origin", 0, 1000);
+  perJointNumbers("simCountsPerRadian", "counts/rad",
+                  "simulated encoders: resolution (one for all joints, or one per joint)", 1, 1e12);
+  schema.addInteger("simSensorDelay", "simulated sensors: delay of the joint readings [servo cycles]", 0,
+                    ManipulatorSimulation::kMaxSensorDelay);
+  schema.addChoice("simFriction", {"on", "off"}, "simulated plant: joint friction");
+  schema.addChoice("simMotorInertia", {"on", "off"}, "simulated plant: reflected motor inertia");
+  perJointNumbers("simInitialPosition", "deg or mm",
+                  "simulated arm: initial joint positions (one per joint; revolute in deg, prismatic in mm)", -1e6, 1e6);
+  perJointNumbers("simInitialVelocity", "deg/s or mm/s",
+                  "simulated arm: initial joint velocities (one per joint; revolute in deg/s, prismatic in mm/s)",
+                  -1e6, 1e6);
+}
+
+std::unique_ptr<ManipulatorSimulation> makeSimulation(const ManipulatorModel& nominal, const ConfigSection* section) {
+  if (section == nullptr) return std::make_unique<ManipulatorSimulation>(nominal);
+  const int n = nominal.getNumberOfJoints();
+  // A setting of one value for all joints or one per joint, as a joint vector (empty if absent).
+  auto joints = [&](const char* name, bool perJointOnly) -> JointVector {
+    const ConfigSetting* s = section->find(name);
+    if (s == nullptr) return JointVector();
+    const std::vector<double> values = section->getNumbers(name);
+    const auto count = static_cast<int>(values.size());
+    if (count != n && (perJointOnly || count != 1)) {
+      throw section->errorAt(*s, std::string(name) + ": " + std::to_string(count) + " values for an arm of " +
+                                     std::to_string(n) + " joints (give " +
+                                     (perJointOnly ? std::to_string(n) : "1 for all joints or " + std::to_string(n)) +
+                                     ")");
+    }
+    JointVector v(n);
+    for (int i = 0; i < n; ++i) v(i) = values[static_cast<std::size_t>(count == 1 ? 0 : i)];
+    return v;
+  };
+  auto onOff = [&](const char* name) {
+    const ConfigSetting* s = section->find(name);
+    return s == nullptr || section->getWord(name) != "off";
+  };
+  // Each deviation is checked where it is read, so that an error names its line.
+  auto check = [&](const char* name, auto&& f) {
+    try {
+      f();
+    } catch (const std::invalid_argument& e) {
+      throw section->errorAt(*section->find(name), e.what());
+    }
+  };
+  PlantDeviations d;
+  d.massScale = joints("simMassScale", false);
+  d.inertiaScale = joints("simInertiaScale", false);
+  d.frictionScale = joints("simFrictionScale", false);
+  if (section->has("simPayload")) d.payload = section->getNumbers("simPayload").at(0);
+  d.friction = onOff("simFriction");
+  d.motorInertia = onOff("simMotorInertia");
+  // Each deviation alone, so that an error names the line of the setting at fault.
+  for (const char* name : {"simMassScale", "simInertiaScale", "simFrictionScale", "simPayload"}) {
+    if (!section->has(name)) continue;
+    PlantDeviations one;
+    const std::string setting = name;
+    if (setting == "simMassScale") one.massScale = d.massScale;
+    if (setting == "simInertiaScale") one.inertiaScale = d.inertiaScale;
+    if (setting == "simFrictionScale") one.frictionScale = d.frictionScale;
+    if (setting == "simPayload") one.payload = d.payload;
+    check(name, [&] { (void)buildPlant(nominal, one); });
+  }
+  const bool deviates = d.massScale.size() > 0 || d.inertiaScale.size() > 0 || d.frictionScale.size() > 0 ||
+                        d.payload > 0 || !d.friction || !d.motorInertia;
+  auto sim = deviates ? std::make_unique<ManipulatorSimulation>(nominal, d) : std::make_unique<ManipulatorSimulation>(nominal);
+
+  if (section->has("integrator"))
+    sim->setIntegrator(section->getWord("integrator") == "euler" ? SimulationIntegrator::Euler : SimulationIntegrator::RK4);
+  const JointVector counts = joints("simCountsPerRadian", false);
+  int delay = 0;
+  if (section->has("simSensorDelay")) delay = static_cast<int>(section->getNumbers("simSensorDelay").at(0));
+  if (counts.size() > 0) check("simCountsPerRadian", [&] { sim->setSensor(counts, 0); });
+  if (delay != 0) check("simSensorDelay", [&] { sim->setSensor(counts, delay); });
+
+  // Initial state: revolute joints in degrees, prismatic ones in millimetres.
+  JointVector q = joints("simInitialPosition", true), qd = joints("simInitialVelocity", true);
+  if (q.size() > 0 || qd.size() > 0) {
+    const double deg = 3.14159265358979323846 / 180.0;
+    for (JointVector* v : {&q, &qd})
+      for (int i = 0; i < v->size(); ++i) (*v)(i) *= nominal.isPrismatic(i) ? 1e-3 : deg;
+    if (q.size() > 0) {
+      for (int i = 0; i < n; ++i)
+        if (q(i) < nominal.getPositionMin()(i) || q(i) > nominal.getPositionMax()(i))
+          throw section->errorAt(*section->find("simInitialPosition"),
+                                 "simInitialPosition: joint " + std::to_string(i + 1) + " is outside its limits");
+    } else {
+      q = sim->getTruePosition();
+    }
+    if (qd.size() == 0) qd = JointVector::Zero(n);
+    sim->setState(q, qd);
+  }
+  return sim;
 }
 
 }  // namespace rp

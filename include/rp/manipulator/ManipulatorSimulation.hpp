@@ -3,44 +3,133 @@
 /// The dynamic simulation of a manipulator's arm: what a manipulator in simulation mode drives.
 
 #include <array>
+#include <memory>
 
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
 
 namespace rp {
 
-/// Integrates a manipulator model's forward dynamics under applied joint torques.
+class ConfigSection;
+class SettingSchema;
+
+/// How ManipulatorSimulation integrates the smooth part of the dynamics over a step.
+enum class SimulationIntegrator {
+  /// Semi-implicit (symplectic) Euler: one forward dynamics per step, first order.
+  Euler,
+  /// The classical fourth-order Runge-Kutta method on the same dynamics: four forward dynamics per
+  /// step; Coulomb friction, brakes and joint stops are then applied as in the Euler step.
+  RK4,
+};
+
+/// How a simulated plant differs from the model the controller has (rp.cfg's `sim...` settings;
+/// see makeSimulation()). The defaults give the nominal plant.
+struct PlantDeviations {
+  JointVector massScale;     ///< factor on each link's mass (n x 1; empty: all 1)
+  JointVector inertiaScale;  ///< factor on each link's inertia tensor about its centre of mass (n x 1; empty: all 1)
+  JointVector frictionScale; ///< factor on each joint's viscous and Coulomb friction (n x 1; empty: all 1)
+  double payload = 0;        ///< point mass at the tool frame's origin, carried by the last link [kg]
+  bool friction = true;      ///< false: no joint friction at all
+  bool motorInertia = true;  ///< false: no reflected motor inertia
+};
+
+/// Integrates a manipulator model's forward dynamics under applied joint torques: the simulated
+/// plant a manipulator in simulation mode drives.
 ///
-/// Each step() integrates the rigid-body dynamics with motor inertia and viscous friction by the
-/// semi-implicit (symplectic) Euler method; Coulomb friction is applied as a velocity impulse that
-/// never reverses the motion, so a joint sticks when the torque is below its Coulomb friction;
-/// torques are saturated at the model's torque limits; joints meet their limits as stiff
-/// spring-damper stops, with sub-steps while a stop is engaged; and brakes hold every joint while
-/// the brakes are on (with a finite braking torque). An external wrench at the end-effector adds \f$J^T F\f$; a wrench at a
-/// point on link \f$k\f$ adds \f$J_k(p)^T F\f$, with \f$J_k(p)\f$ the geometric Jacobian of that
-/// point (columns of joints beyond \f$k\f$ zero).
+/// Each step() integrates the rigid-body dynamics with motor inertia and viscous friction, either
+/// by the semi-implicit Euler method or by RK4 (setIntegrator(); RK4 by default). Coulomb friction
+/// and engaged brakes act through the full mass matrix, as a constraint: the velocity \f$v^+\f$ at
+/// the end of a step minimises \f$\frac12 (v^+ - v^*)^T A (v^+ - v^*) + h \sum_i f_i(v^+_i)\f$,
+/// where \f$v^*\f$ is the velocity without them, \f$A\f$ the mass matrix (plus the implicit terms
+/// below) and \f$f_i(v) = F^+_i v\f$ for \f$v > 0\f$, \f$-F^-_i v\f$ for \f$v < 0\f$ the friction's
+/// dissipation (\f$F^\pm_i\f$ the joint's Coulomb friction, plus its braking torque while the
+/// brakes are on). Its optimality conditions are stick and slip exactly: a sliding joint feels
+/// \f$F^\pm_i\f$ against its motion, a joint at rest stays there while the torque holding it
+/// (which reaches the other joints through \f$M\f$) is within \f$[-F^+_i, F^-_i]\f$. It is solved
+/// by exact coordinate descent (a convex problem; bounded iterations, no allocation).
+///
+/// Torques are saturated at the model's torque limits. Joints meet their limits as stiff
+/// spring-damper stops (setStopStiffness()), critically damped for the inertia of the joint at the
+/// stop, with the spring, the damper and viscous friction implicit in the velocity (backward Euler:
+/// stable and dissipative for any inertia); while a stop is engaged a step is taken by the Euler
+/// method in sub-steps sized from the stop's frequency on that joint. Brakes hold every joint while
+/// the brakes are on (with a finite braking torque). An external wrench at the end-effector adds
+/// \f$J^T F\f$; a wrench at a point on link \f$k\f$ adds \f$J_k(p)^T F\f$, with \f$J_k(p)\f$ the
+/// geometric Jacobian of that point (columns of joints beyond \f$k\f$ zero).
+///
+/// The plant may differ from the model the controller has (PlantDeviations; the simulation then
+/// owns its own model), and its joints are read through simulated sensors: getPosition() and
+/// getVelocity() give the readings (quantised to the encoder resolution, delayed by a number of
+/// steps, see setSensor()), getTruePosition() and getTrueVelocity() the plant's state.
 ///
 /// Deterministic: the same inputs give bit-identical states. Nothing allocates after construction.
 class ManipulatorSimulation {
  public:
-  /// Creates a simulation at rest in `model`'s home position.
+  /// Largest sensor delay [steps].
+  static constexpr int kMaxSensorDelay = 16;
+
+  /// Creates a simulation at rest in `model`'s home position, of the nominal plant.
   /// @param[in] model  the manipulator model (must outlive the simulation)
   explicit ManipulatorSimulation(const ManipulatorModel& model);
+  /// Creates a simulation at rest in `nominal`'s home position of a plant that differs from it:
+  /// the simulation builds and owns the plant's model; `nominal` is not changed.
+  /// @param[in] nominal     the model the controller has (read only during construction)
+  /// @param[in] deviations  how the plant differs
+  /// @throws std::invalid_argument on a deviation vector that has neither 0 nor n entries, or a
+  ///         factor that is not positive and finite (friction: not negative), or a negative payload
+  ManipulatorSimulation(const ManipulatorModel& nominal, const PlantDeviations& deviations);
+  ~ManipulatorSimulation();
+  ManipulatorSimulation(const ManipulatorSimulation&) = delete;             ///< not copyable
+  ManipulatorSimulation& operator=(const ManipulatorSimulation&) = delete;  ///< not copyable
 
-  /// Advances the simulation by `dt` under the joint torques `tau`.
+  /// Declares the rp.cfg settings makeSimulation() reads (a manipulator's declareSettings()
+  /// calls it).
+  /// @param[in,out] schema  the class's schema
+  static void declareSettings(SettingSchema& schema);
+
+  /// Advances the simulation by `dt` under the joint torques `tau`, and takes one sensor reading.
   /// @param[in] tau  motor torques at the joints (n x 1) [N m]
   /// @param[in] dt   time step [s] (> 0)
   /// Real-time safe: yes.
   void step(const JointVector& tau, double dt);
 
-  /// Joint positions (n x 1) [rad]. Real-time safe: yes.
-  const JointVector& getPosition() const { return q_; }
-  /// Joint velocities (n x 1) [rad/s]. Real-time safe: yes.
-  const JointVector& getVelocity() const { return qd_; }
-  /// Joint accelerations of the last step (n x 1) [rad/s^2]. Real-time safe: yes.
+  /// Joint positions as the simulated encoders read them (n x 1) [rad]: the plant's, quantised to
+  /// the encoder resolution and as old as the sensor delay (see setSensor()); the true positions
+  /// without them. Real-time safe: yes.
+  const JointVector& getPosition() const { return readPosition_[readIndex()]; }
+  /// Joint velocities as read (n x 1) [rad/s]: the plant's, as old as the sensor delay (not
+  /// quantised). Real-time safe: yes.
+  const JointVector& getVelocity() const { return readVelocity_[readIndex()]; }
+  /// The plant's joint positions (n x 1) [rad]. Real-time safe: yes.
+  const JointVector& getTruePosition() const { return q_; }
+  /// The plant's joint velocities (n x 1) [rad/s]. Real-time safe: yes.
+  const JointVector& getTrueVelocity() const { return qd_; }
+  /// Joint accelerations at the start of the last step (or sub-step) (n x 1) [rad/s^2]: the
+  /// forward dynamics under the applied and external torques, gravity, viscous friction and the
+  /// stops' springs, before Coulomb friction and brakes. Real-time safe: yes.
   const JointVector& getAcceleration() const { return qdd_; }
-  /// Puts the arm at rest in `q` [rad]. Real-time safe: yes.
+  /// Puts the arm in `q` [rad] with velocities `qd` [rad/s]; the sensors read that state
+  /// (their delay line is filled with it). Real-time safe: yes.
   void setState(const JointVector& q, const JointVector& qd);
+
+  /// Sets the simulated sensors. Real-time safe: no.
+  /// @param[in] countsPerRadian  encoder resolution per joint [counts/rad] (n x 1, each > 0, or
+  ///                             infinite for exact readings); empty: exact readings
+  /// @param[in] delay            steps between the plant's state and its reading (0..kMaxSensorDelay)
+  /// @throws std::invalid_argument on a wrong size, a resolution that is not positive, or a delay
+  ///         out of range
+  void setSensor(const JointVector& countsPerRadian, int delay);
+  /// The sensor delay [steps].
+  int getSensorDelay() const { return delay_; }
+
+  /// Selects the integrator (takes effect at the next step). Real-time safe: yes.
+  /// @param[in] integrator  Euler or RK4
+  void setIntegrator(SimulationIntegrator integrator) { integrator_ = integrator; }
+  /// The integrator.
+  SimulationIntegrator getIntegrator() const { return integrator_; }
+
+  /// The plant's model: the one given to the constructor, or the simulation's own with deviations.
+  const ManipulatorModel& getModel() const { return model_; }
 
   /// Engages (true) or releases (false) the brakes. Engaged brakes act as real ones do: the
   /// motors are off (the applied torques are ignored) and each joint's brake opposes its motion
@@ -85,20 +174,50 @@ class ManipulatorSimulation {
   int getLastSubsteps() const { return lastSubsteps_; }
 
  private:
-  void integrate(const JointVector& tau, double h);
+  void init();
+  void appliedTorque(const JointVector& tau);
+  void eulerStep(double h);
+  void rk4Step(double h);
+  void solveFriction(double h);
+  void recordReading();
+  std::size_t readIndex() const {
+    return static_cast<std::size_t>((head_ + kMaxSensorDelay + 1 - delay_) % (kMaxSensorDelay + 1));
+  }
   void externalTorque();
 
+  std::unique_ptr<const ManipulatorModel> own_;  // the plant's model when it deviates
   const ManipulatorModel& model_;
   ManipulatorData data_;
-  JointVector q_, qd_, qdd_, tauTotal_, tauExt_, coulombPos_, coulombNeg_, brakeTorque_;
+  JointVector q_, qd_, qdd_, tauTotal_, tauExt_, tauApplied_, coulombPos_, coulombNeg_, brakeTorque_, viscous_;
+  // Scratch of the steps: implicit diagonal, right-hand side, residual, friction bounds, RK4 stages.
+  JointVector diag_, rhs_, residual_, upper_, lower_, q0_, v0_, kq_, kv_, sumQ_, sumV_;
+  JointMatrix A_, L_;
+  std::array<bool, kMaxJoints> engaged_{};  // joints whose stop acts in the current Euler step
   Vector<6> wrench_;
   std::array<Vector<3>, kMaxJoints> linkPoint_{};
   std::array<Vector<6>, kMaxJoints> linkWrench_{};
   int linkWrenches_ = 0;  // number of links with a non-zero wrench
   bool brakes_ = false;
+  bool hasCoulomb_ = false;
   double stopStiffness_ = 2e4;
   int lastSubsteps_ = 1;
+  SimulationIntegrator integrator_ = SimulationIntegrator::RK4;
   DynamicsOptions options_;
+  // Sensors: a ring of the last kMaxSensorDelay + 1 readings; head_ is the newest.
+  JointVector countsPerRadian_;
+  int delay_ = 0;
+  int head_ = 0;
+  std::array<JointVector, kMaxSensorDelay + 1> readPosition_{}, readVelocity_{};
 };
+
+/// Creates the simulated plant of a manipulator from its rp.cfg section (which may be null): the
+/// nominal `model`, or a plant that deviates from it as the section's `sim...` settings say, with
+/// the section's `integrator`, sensors and initial state. The controller keeps `nominal`.
+/// @param[in] nominal  the controller's model (must outlive the simulation when it has no deviations)
+/// @param[in] section  the manipulator's rp.cfg section, or nullptr
+/// @return the simulation
+/// @throws ConfigError naming the file and line of a setting with the wrong number of values
+///         for the arm's joints, or a value the plant cannot take
+std::unique_ptr<ManipulatorSimulation> makeSimulation(const ManipulatorModel& nominal, const ConfigSection* section);
 
 }  // namespace rp

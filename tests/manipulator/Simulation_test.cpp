@@ -1,0 +1,594 @@
+// The simulated plant (ManipulatorSimulation) against physics it must have: Coulomb friction
+// through the full mass matrix (against an independent integration of the model's forward
+// dynamics with the same friction law), joint stops that are stable and dissipative on every joint
+// of every arm, the RK4 integrator's accuracy against a fine-step ground truth, plant deviations
+// and simulated sensors from rp.cfg, and no allocation while stepping.
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <unistd.h>
+
+#include "AllocationCounter.hpp"
+#include "MjcfArm.hpp"
+#include "SimulatedArmTest.hpp"
+#include "rp/RoboticPlatform.hpp"
+#include "rp/manipulator/ManipulatorSimulation.hpp"
+#include "rp/model/Model.hpp"
+
+namespace rp {
+namespace {
+
+std::vector<std::unique_ptr<ManipulatorModel>> allArms() {
+  std::vector<std::unique_ptr<ManipulatorModel>> arms;
+  arms.push_back(std::make_unique<Puma560Model>());
+  arms.push_back(std::make_unique<WAM4Model>());
+  arms.push_back(std::make_unique<WAM7Model>());
+  return arms;
+}
+
+double coulombPos(const LinkParameters& l) { return std::abs(l.gearRatio * l.coulombFrictionPositive); }
+double coulombNeg(const LinkParameters& l) { return std::abs(l.gearRatio * l.coulombFrictionNegative); }
+
+// ---- Coulomb friction through the full dynamics ------------------------------------------------
+
+// In a sliding state (every joint moving fast enough not to stop within the step) a short step
+// must change the velocity by the model's forward dynamics with its own friction law (viscous and
+// Coulomb, DynamicsOptions::friction), which couples the joints through M^-1: the friction of one
+// joint accelerates the others.
+TEST(SimulationFriction, SlidingAccelerationIsTheModelsForwardDynamicsWithFriction) {
+  std::mt19937 rng(7);
+  for (const auto& model : allArms()) {
+    const int n = model->getNumberOfJoints();
+    ManipulatorData data(*model);
+    DynamicsOptions options;
+    options.motorInertia = true;
+    options.friction = true;
+    for (SimulationIntegrator integrator : {SimulationIntegrator::Euler, SimulationIntegrator::RK4}) {
+      ManipulatorSimulation sim(*model);
+      sim.setIntegrator(integrator);
+      double worst = 0, largest = 0;
+      for (int trial = 0; trial < 20; ++trial) {
+        JointVector q(n), qd(n), tau(n);
+        for (int i = 0; i < n; ++i) {
+          std::uniform_real_distribution<double> in(model->getPositionMin()(i) + 0.1, model->getPositionMax()(i) - 0.1);
+          q(i) = in(rng);
+          qd(i) = std::uniform_real_distribution<double>(0.2, 1.0)(rng) * (rng() % 2 ? 1 : -1);
+          tau(i) = std::uniform_real_distribution<double>(-0.3, 0.3)(rng) * model->getTorqueLimit()(i);
+        }
+        const double h = 1e-6;
+        sim.setState(q, qd);
+        sim.step(tau, h);
+        const JointVector measured = (sim.getTrueVelocity() - qd) / h;
+        const JointVector& expected = forwardDynamics(*model, data, q, qd, tau, options);
+        worst = std::max(worst, (measured - expected).cwiseAbs().maxCoeff());
+        largest = std::max(largest, expected.cwiseAbs().maxCoeff());
+      }
+      std::printf("  %s %s: largest acceleration %.3g rad/s^2, worst difference %.3g\n", model->getName().c_str(),
+                  integrator == SimulationIntegrator::RK4 ? "rk4" : "euler", largest, worst);
+      EXPECT_LT(worst, 1e-3 * largest) << model->getName();
+    }
+  }
+}
+
+// The reference: the model's forward dynamics with Coulomb friction in a fixed contact mode (each
+// joint stuck, sliding up or sliding down), integrated by RK4 at 0.1 ms. The mode at the start is
+// the one that satisfies Coulomb's law (found among all 3^n); along the run the reference checks
+// that it stays valid (a sliding joint does not reverse, a stuck joint's holding torque stays
+// within its friction), so the comparison is with the true solution of the friction law.
+struct FrictionReference {
+  const ManipulatorModel& model;
+  ManipulatorData data;
+  std::vector<int> mode;  // 0 stuck, +1 sliding up, -1 sliding down
+  JointVector tau;
+  bool valid = true;
+
+  FrictionReference(const ManipulatorModel& m, const JointVector& q, const JointVector& t)
+      : model(m), data(m), tau(t) {
+    const int n = m.getNumberOfJoints();
+    int total = 1;
+    for (int i = 0; i < n; ++i) total *= 3;
+    std::vector<std::vector<int>> valid;
+    for (int code = 0; code < total; ++code) {
+      std::vector<int> trial(static_cast<std::size_t>(n));
+      for (int i = 0, c = code; i < n; ++i, c /= 3) trial[static_cast<std::size_t>(i)] = c % 3 - 1;
+      mode = trial;
+      JointVector qdd, hold;
+      accelerations(q, JointVector::Zero(n), qdd, hold);
+      bool ok = true;
+      for (int i = 0; i < n; ++i) {
+        const int s = trial[static_cast<std::size_t>(i)];
+        const LinkParameters& l = m.getLink(i);
+        if (s == 0 && !(hold(i) <= coulombNeg(l) && hold(i) >= -coulombPos(l))) ok = false;
+        if (s != 0 && !(s * qdd(i) > 0)) ok = false;
+      }
+      if (ok) valid.push_back(trial);
+    }
+    // M is positive definite, so Coulomb's law gives exactly one mode.
+    EXPECT_EQ(valid.size(), 1u);
+    if (!valid.empty()) mode = valid.front();
+  }
+
+  // Accelerations in the mode; `hold` is the torque the stuck joints need (what friction supplies).
+  void accelerations(const JointVector& q, const JointVector& qd, JointVector& qdd, JointVector& hold) {
+    const int n = model.getNumberOfJoints();
+    JointVector t = tau;
+    for (int i = 0; i < n; ++i) {
+      const LinkParameters& l = model.getLink(i);
+      const int s = mode[static_cast<std::size_t>(i)];
+      t(i) -= l.viscousFriction * l.gearRatio * l.gearRatio * qd(i);
+      if (s > 0) t(i) -= coulombPos(l);
+      if (s < 0) t(i) += coulombNeg(l);
+    }
+    DynamicsOptions options;
+    options.motorInertia = true;
+    const JointVector bias = inverseDynamics(model, data, q, qd, JointVector::Zero(n), options);
+    const JointMatrix M = massMatrix(model, data, q, true);
+    std::vector<int> freeJoints;
+    for (int i = 0; i < n; ++i)
+      if (mode[static_cast<std::size_t>(i)] != 0) freeJoints.push_back(i);
+    const auto f = static_cast<int>(freeJoints.size());
+    Eigen::MatrixXd Mf(f, f);
+    Eigen::VectorXd rhs(f);
+    for (int a = 0; a < f; ++a) {
+      rhs(a) = t(freeJoints[static_cast<std::size_t>(a)]) - bias(freeJoints[static_cast<std::size_t>(a)]);
+      for (int b = 0; b < f; ++b) Mf(a, b) = M(freeJoints[static_cast<std::size_t>(a)], freeJoints[static_cast<std::size_t>(b)]);
+    }
+    const Eigen::VectorXd x = f > 0 ? Eigen::VectorXd(Mf.ldlt().solve(rhs)) : Eigen::VectorXd();
+    qdd.setZero(n);
+    for (int a = 0; a < f; ++a) qdd(freeJoints[static_cast<std::size_t>(a)]) = x(a);
+    // Holding torque of the stuck joints: M qdd + bias - t on their rows.
+    hold = M * qdd + bias - t;
+    for (int i = 0; i < n; ++i)
+      if (mode[static_cast<std::size_t>(i)] != 0) hold(i) = 0;
+  }
+
+  // Integrates for `duration` from rest at q by RK4 at `h`; returns the final positions.
+  JointVector run(JointVector q, double duration, double h) {
+    const int n = model.getNumberOfJoints();
+    JointVector v = JointVector::Zero(n), a1, a2, a3, a4, hold;
+    const int steps = static_cast<int>(std::lround(duration / h));
+    for (int k = 0; k < steps; ++k) {
+      accelerations(q, v, a1, hold);
+      for (int i = 0; i < n; ++i) {
+        const LinkParameters& l = model.getLink(i);
+        const int s = mode[static_cast<std::size_t>(i)];
+        if (s == 0 && !(hold(i) <= coulombNeg(l) && hold(i) >= -coulombPos(l))) valid = false;
+        if (s != 0 && k > 0 && !(s * v(i) > 0)) valid = false;
+      }
+      const JointVector v2 = v + 0.5 * h * a1;
+      accelerations(q + 0.5 * h * v, v2, a2, hold);
+      const JointVector v3 = v + 0.5 * h * a2;
+      accelerations(q + 0.5 * h * v2, v3, a3, hold);
+      const JointVector v4 = v + h * a3;
+      accelerations(q + h * v3, v4, a4, hold);
+      q += (h / 6) * (v + 2 * v2 + 2 * v3 + v4);
+      v += (h / 6) * (a1 + 2 * a2 + 2 * a3 + a4);
+    }
+    return q;
+  }
+};
+
+// The Puma's shoulder falls freely (no torque) with the upper arm starting horizontal: its
+// friction, and the torques that hold the joints that stick, act through the full mass matrix.
+TEST(SimulationFriction, PumaShoulderFreeFallMatchesTheReference) {
+  Puma560Model model;
+  JointVector q = model.getHomePosition();
+  q(1) = 0;  // upper arm horizontal
+  q(2) = 0.3;
+  const JointVector zero = JointVector::Zero(6);
+  const double duration = 0.3;
+  FrictionReference reference(model, q, zero);
+  const JointVector expected = reference.run(q, duration, 1e-4);
+  ASSERT_TRUE(reference.valid) << "the contact mode changed during the reference run";
+  std::printf("  reference mode:");
+  for (int s : reference.mode) std::printf(" %d", s);
+  std::printf("\n");
+  ASSERT_NE(reference.mode[1], 0) << "the shoulder should slide";
+  const double fall = expected(1) - q(1);
+  for (SimulationIntegrator integrator : {SimulationIntegrator::Euler, SimulationIntegrator::RK4}) {
+    ManipulatorSimulation sim(model);
+    sim.setIntegrator(integrator);
+    sim.setState(q, zero);
+    for (int k = 0; k < 300; ++k) sim.step(zero, 1e-3);
+    const JointVector& got = sim.getTruePosition();
+    std::printf("  %s: shoulder fell %.2f mrad in %.1f s (reference %.2f mrad); worst joint difference %.3g rad\n",
+                integrator == SimulationIntegrator::RK4 ? "rk4" : "euler", 1e3 * (got(1) - q(1)), duration, 1e3 * fall,
+                (got - expected).cwiseAbs().maxCoeff());
+    EXPECT_NEAR(got(1) - q(1), fall, 0.02 * std::abs(fall));
+    for (int i = 0; i < 6; ++i) {
+      if (reference.mode[static_cast<std::size_t>(i)] == 0) {
+        EXPECT_EQ(got(i), q(i)) << "joint " << i + 1 << " is held by its friction";
+      } else {
+        EXPECT_NEAR(got(i), expected(i), 0.02 * std::abs(expected(i) - q(i)) + 1e-4) << "joint " << i + 1;
+      }
+    }
+  }
+}
+
+// The same free fall in MuJoCo (Debian's libmujoco-dev), an independent simulator: the arm as MJCF
+// (same DH frames, masses, inertias, armature and damping), each joint's dry friction as MuJoCo's
+// frictionloss (two-sided in MuJoCo: the shoulder gets the side it slides on, the others the
+// smaller side, which still holds them), RK4 at 0.1 ms. MuJoCo's friction is a soft constraint
+// (a joint that sticks creeps a little), so the shoulder's fall agrees to about 1 %.
+TEST(SimulationFriction, PumaShoulderFreeFallAgreesWithMuJoCo) {
+  Puma560Model model;
+  JointVector q = model.getHomePosition();
+  q(1) = 0;
+  q(2) = 0.3;
+  std::vector<double> friction;
+  for (int i = 0; i < 6; ++i) {
+    const LinkParameters& l = model.getLink(i);
+    friction.push_back(i == 1 ? coulombNeg(l) : std::min(coulombPos(l), coulombNeg(l)));
+  }
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("rp_simulation_test_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(file) << test::mjcf(model, true, friction);
+  char error[1000] = "";
+  mjModel* m = mj_loadXML(file.c_str(), nullptr, error, sizeof error);
+  std::filesystem::remove(file);
+  ASSERT_NE(m, nullptr) << error;
+  m->opt.integrator = mjINT_RK4;
+  m->opt.timestep = 1e-4;
+  mjData* d = mj_makeData(m);
+  for (int i = 0; i < 6; ++i) d->qpos[i] = q(i);
+  for (int k = 0; k < 3000; ++k) mj_step(m, d);
+  const double mujocoFall = d->qpos[1] - q(1);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+
+  const JointVector zero = JointVector::Zero(6);
+  for (SimulationIntegrator integrator : {SimulationIntegrator::Euler, SimulationIntegrator::RK4}) {
+    ManipulatorSimulation sim(model);
+    sim.setIntegrator(integrator);
+    sim.setState(q, zero);
+    for (int k = 0; k < 300; ++k) sim.step(zero, 1e-3);
+    const double fall = sim.getTruePosition()(1) - q(1);
+    std::printf("  %s: shoulder fell %.2f mrad in 0.3 s, MuJoCo %.2f mrad\n",
+                integrator == SimulationIntegrator::RK4 ? "rk4" : "euler", 1e3 * fall, 1e3 * mujocoFall);
+    EXPECT_NEAR(fall, mujocoFall, 0.015 * std::abs(mujocoFall));
+  }
+}
+
+// ---- Joint stops -------------------------------------------------------------------------------
+
+// Every joint of every arm hits each of its stops at 1 rad/s (the other joints at rest, no torque): the stop must send it back no faster than it came, the energy (kinetic
+// plus the stop spring's) must never grow, and nothing diverges. The
+// impact may whip the other joints (momentum moves through M), but not with energy from nowhere.
+TEST(SimulationStops, EveryJointHitsItsStopsWithoutGainingEnergy) {
+  for (const auto& arm : allArms()) {
+    const int n = arm->getNumberOfJoints();
+    // Without gravity (the WAM 7's shoulder cannot hold itself up within its torque limit, so
+    // gravity would add energy): the energy is the kinetic energy and the stop springs'.
+    std::vector<LinkParameters> links;
+    for (int i = 0; i < n; ++i) links.push_back(arm->getLink(i));
+    const auto model = std::make_unique<ManipulatorModel>(arm->getName(), links, arm->getBaseTransform(),
+                                                          arm->getToolTransform(), Vector<3>());
+    ManipulatorData data(*model);
+    for (SimulationIntegrator integrator : {SimulationIntegrator::Euler, SimulationIntegrator::RK4}) {
+      for (int i = 0; i < n; ++i) {
+        for (int side : {-1, 1}) {
+          ManipulatorSimulation sim(*model);
+          sim.setIntegrator(integrator);
+          JointVector q = arm->getHomePosition(), qd = JointVector::Zero(n), tau = JointVector::Zero(n);
+          const double limit = side > 0 ? model->getPositionMax()(i) : model->getPositionMin()(i);
+          q(i) = limit - side * 0.01;
+          qd(i) = side * 1.0;
+          sim.setState(q, qd);
+          double impact = 0, rebound = 0, fastest = 0, deepest = 0, energy0 = 0, energy = 0;
+          auto energyOf = [&](const ManipulatorSimulation& s) {
+            const JointVector& v = s.getTrueVelocity();
+            double spring = 0;
+            for (int j = 0; j < n; ++j) {
+              const double x = std::max({0.0, model->getPositionMin()(j) - s.getTruePosition()(j),
+                                         s.getTruePosition()(j) - model->getPositionMax()(j)});
+              spring += 0.5 * 2e4 * x * x;
+            }
+            return 0.5 * v.dot(massMatrix(*model, data, s.getTruePosition(), true) * v) + spring;
+          };
+          energy0 = energyOf(sim);
+          bool finite = true;
+          for (int k = 0; k < 500; ++k) {
+            const double before = sim.getTrueVelocity()(i);
+            const bool outside = side * (sim.getTruePosition()(i) - limit) > 0;
+            if (!outside && impact == 0 && side * before > 0 && side * (sim.getTruePosition()(i) + 1e-3 * before - limit) > 0)
+              impact = std::abs(before);
+            sim.step(tau, 1e-3);
+            const JointVector& v = sim.getTrueVelocity();
+            finite = finite && v.allFinite() && sim.getTruePosition().allFinite();
+            fastest = std::max(fastest, v.cwiseAbs().maxCoeff());
+            deepest = std::max(deepest, side * (sim.getTruePosition()(i) - limit));
+            rebound = std::max(rebound, -side * v(i));
+            energy = std::max(energy, energyOf(sim));
+          }
+          std::printf("  %s %s joint %d %s stop: impact %.3f rad/s, rebound %.3f rad/s, depth %.2g rad, fastest %.3f rad/s, "
+                      "largest energy %.3g of %.3g J\n",
+                      model->getName().c_str(), integrator == SimulationIntegrator::RK4 ? "rk4" : "euler", i + 1,
+                      side > 0 ? "upper" : "lower", impact, rebound, deepest, fastest, energy, energy0);
+          ASSERT_TRUE(finite) << model->getName() << " joint " << i + 1;
+          EXPECT_GT(impact, 0.5) << model->getName() << " joint " << i + 1 << " should reach its stop";
+          EXPECT_LE(rebound, impact) << model->getName() << " joint " << i + 1;
+          EXPECT_LE(energy, 1.01 * energy0) << model->getName() << " joint " << i + 1 << ": energy from nowhere";
+          EXPECT_LT(fastest, 10.0) << model->getName() << " joint " << i + 1;
+          EXPECT_LT(deepest, 0.05) << model->getName() << " joint " << i + 1;
+        }
+      }
+    }
+  }
+}
+
+// ---- Integrators -------------------------------------------------------------------------------
+
+// 2 s of free motion (no gravity, no friction: the arm coasts, coupled through M and C) from the
+// middle of the ranges, against the model's forward dynamics integrated by RK4 at 10 us in the
+// test. RK4 at the servo period is far more accurate than Euler.
+TEST(SimulationIntegrator, Rk4IsFarMoreAccurateThanEulerInFreeMotion) {
+  for (const auto& nominal : allArms()) {
+    const int n = nominal->getNumberOfJoints();
+    std::vector<LinkParameters> links;
+    for (int i = 0; i < n; ++i) {
+      LinkParameters l = nominal->getLink(i);
+      l.viscousFriction = l.coulombFrictionPositive = l.coulombFrictionNegative = 0;
+      links.push_back(l);
+    }
+    const ManipulatorModel model(nominal->getName(), links, nominal->getBaseTransform(), nominal->getToolTransform(),
+                                 Vector<3>());
+    JointVector q0(n), v0(n);
+    for (int i = 0; i < n; ++i) {
+      q0(i) = 0.5 * (model.getPositionMin()(i) + model.getPositionMax()(i));
+      v0(i) = (i % 2 ? -0.3 : 0.4);
+    }
+    // The ground truth.
+    ManipulatorData data(model);
+    DynamicsOptions options;
+    options.motorInertia = true;
+    const JointVector zero = JointVector::Zero(n);
+    JointVector q = q0, v = v0;
+    const double h = 1e-5;
+    for (int k = 0; k < 200000; ++k) {
+      const JointVector a1 = forwardDynamics(model, data, q, v, zero, options);
+      const JointVector v2 = v + 0.5 * h * a1;
+      const JointVector a2 = forwardDynamics(model, data, q + 0.5 * h * v, v2, zero, options);
+      const JointVector v3 = v + 0.5 * h * a2;
+      const JointVector a3 = forwardDynamics(model, data, q + 0.5 * h * v2, v3, zero, options);
+      const JointVector v4 = v + h * a3;
+      const JointVector a4 = forwardDynamics(model, data, q + h * v3, v4, zero, options);
+      q += (h / 6) * (v + 2 * v2 + 2 * v3 + v4);
+      v += (h / 6) * (a1 + 2 * a2 + 2 * a3 + a4);
+    }
+    ASSERT_TRUE(model.isWithinLimits(q)) << "the test motion should stay clear of the stops";
+    double error[2];
+    for (SimulationIntegrator integrator : {SimulationIntegrator::Euler, SimulationIntegrator::RK4}) {
+      ManipulatorSimulation sim(model);
+      sim.setIntegrator(integrator);
+      sim.setState(q0, v0);
+      for (int k = 0; k < 2000; ++k) sim.step(zero, 1e-3);
+      error[integrator == SimulationIntegrator::RK4] = (sim.getTruePosition() - q).cwiseAbs().maxCoeff();
+    }
+    std::printf("  %s: 2 s free motion, largest joint error euler %.3g rad, rk4 %.3g rad\n", model.getName().c_str(),
+                error[0], error[1]);
+    EXPECT_LT(error[1], 1e-6) << model.getName();
+    EXPECT_LT(error[1], 1e-3 * error[0]) << model.getName();
+  }
+}
+
+// ---- A plant that differs from the controller's model -------------------------------------------
+
+const ConfigSection& section(const Configuration& config) { return config.sections().front(); }
+
+TEST(SimulationPlant, DeviationsFromRpCfgChangeThePlantOnly) {
+  Puma560Model nominal;
+  const Configuration config = Configuration::parse(
+      "[puma]\nclass Puma560\nsimMassScale 1.1\nsimInertiaScale 1.2\nsimFrictionScale 1.3\nsimPayload 2\n"
+      "integrator euler\n", "rp.cfg");
+  const std::unique_ptr<ManipulatorSimulation> sim = makeSimulation(nominal, &section(config));
+  const ManipulatorModel& plant = sim->getModel();
+  ASSERT_NE(&plant, &nominal);
+  EXPECT_EQ(sim->getIntegrator(), SimulationIntegrator::Euler);
+  const Puma560Model fresh;
+  for (int i = 0; i < 6; ++i) {
+    const LinkParameters &p = plant.getLink(i), &l = nominal.getLink(i);
+    EXPECT_EQ(l.mass, fresh.getLink(i).mass) << "the controller's model is unchanged";
+    EXPECT_EQ(Eigen::Matrix3d(l.inertia), Eigen::Matrix3d(fresh.getLink(i).inertia));
+    if (i < 5) {
+      EXPECT_DOUBLE_EQ(p.mass, 1.1 * l.mass);
+      EXPECT_TRUE(Eigen::Matrix3d(p.inertia).isApprox(1.2 * Eigen::Matrix3d(l.inertia)));
+    } else {
+      EXPECT_DOUBLE_EQ(p.mass, 1.1 * l.mass + 2);  // the payload rides on the last link
+    }
+    EXPECT_DOUBLE_EQ(p.viscousFriction, 1.3 * l.viscousFriction);
+    EXPECT_DOUBLE_EQ(p.coulombFrictionPositive, 1.3 * l.coulombFrictionPositive);
+  }
+  // The payload: a point mass at the tool frame's origin. Its gravity torque is that of the mass
+  // there: the plant's gravity torque minus the scaled links' is J_v^T (0, 0, m g).
+  const JointVector q = nominal.getHomePosition();
+  const Configuration noPayload = Configuration::parse("[puma]\nclass Puma560\nsimMassScale 1.1\n", "rp.cfg");
+  const auto scaled = makeSimulation(nominal, &section(noPayload));
+  ManipulatorData d1(plant), d2(scaled->getModel()), d3(nominal);
+  JointVector g1, g2;
+  gravityTorque(plant, d1, q, g1);
+  gravityTorque(scaled->getModel(), d2, q, g2);
+  Vector<6> weight;
+  weight(2) = -2 * 9.81;
+  const JointVector expected = jacobian(nominal, d3, q, ReferenceFrame::Base).transpose() * weight;
+  EXPECT_LT((g1 - g2 + expected).cwiseAbs().maxCoeff(), 1e-9) << "payload torque";
+}
+
+TEST(SimulationPlant, SwitchesSensorsAndInitialState) {
+  Puma560Model nominal;
+  const Configuration config = Configuration::parse(
+      "[puma]\nclass Puma560\nsimFriction off\nsimMotorInertia off\nsimCountsPerRadian 1000\nsimSensorDelay 3\n"
+      "simInitialPosition 10 20 -30 0 40 0\nsimInitialVelocity 0 0 0 0 0 30\n", "rp.cfg");
+  const auto sim = makeSimulation(nominal, &section(config));
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(sim->getModel().getLink(i).coulombFrictionPositive, 0);
+    EXPECT_EQ(sim->getModel().getLink(i).viscousFriction, 0);
+    EXPECT_EQ(sim->getModel().getArmatureInertia()(i), 0);
+    EXPECT_GT(nominal.getArmatureInertia()(i), 0);
+  }
+  const double deg = std::acos(-1.0) / 180;
+  EXPECT_DOUBLE_EQ(sim->getTruePosition()(1), 20 * deg);
+  EXPECT_DOUBLE_EQ(sim->getTrueVelocity()(5), 30 * deg);
+  // Quantised to 1/1000 rad (the count below), and three steps old.
+  std::vector<JointVector> truth{sim->getTruePosition()};
+  JointVector tau;
+  ManipulatorData data(sim->getModel());
+  for (int k = 0; k < 10; ++k) {
+    gravityTorque(sim->getModel(), data, sim->getTruePosition(), tau);
+    sim->step(tau, 1e-3);
+    truth.push_back(sim->getTruePosition());
+    const JointVector& read = sim->getPosition();
+    const JointVector& old = truth[static_cast<std::size_t>(std::max(0, k + 1 - 3))];
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_EQ(read(i), std::floor(old(i) * 1000) / 1000) << "step " << k << " joint " << i + 1;
+      EXPECT_NEAR(std::round(read(i) * 1000), read(i) * 1000, 1e-9);
+    }
+  }
+  EXPECT_NE(sim->getPosition()(5), sim->getTruePosition()(5));
+}
+
+TEST(SimulationPlant, BadSettingsAreConfigErrorsWithTheLine) {
+  Puma560Model nominal;
+  auto expectError = [&](const std::string& text, const std::string& where) {
+    try {
+      const Configuration config = Configuration::parse(text, "rp.cfg");
+      (void)makeSimulation(nominal, &section(config));
+      ADD_FAILURE() << "no error for:\n" << text;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+    }
+  };
+  expectError("[puma]\nclass Puma560\nsimMassScale 1 1 1\n", "rp.cfg:3:");
+  expectError("[puma]\nclass Puma560\nsimMassScale -1\n", "rp.cfg:3:");
+  expectError("[puma]\nclass Puma560\n\nsimInitialPosition 0 0\n", "rp.cfg:4:");
+  expectError("[puma]\nclass Puma560\nsimInitialPosition 0 0 0 0 0 500\n", "rp.cfg:3:");
+  expectError("[puma]\nclass Puma560\nsimSensorDelay 100\n", "rp.cfg:3:");
+  expectError("[puma]\nclass Puma560\nintegrator midpoint\n", "rp.cfg:3:");
+  expectError("[puma]\nclass Puma560\nsimCountsPerRadian 0\n", "rp.cfg:3:");
+  // Unchecked by the schema (a configuration read without the class checks), makeSimulation's
+  // own checks still name the line of the setting at fault.
+  Configuration::Options unchecked;
+  unchecked.checkClasses = false;
+  unchecked.loadPlugins = false;
+  for (const auto& [text, where] : std::vector<std::pair<std::string, std::string>>{
+           {"[puma]\nclass Puma560\nsimMassScale 1.1\nsimPayload -3\n", "rp.cfg:4:"},
+           {"[puma]\nclass Puma560\nsimFrictionScale -1\nsimPayload 3\n", "rp.cfg:3:"},
+           {"[puma]\nclass Puma560\nsimCountsPerRadian 100\nsimSensorDelay 17\n", "rp.cfg:4:"}}) {
+    try {
+      const Configuration config = Configuration::parse(text, "rp.cfg", unchecked);
+      (void)makeSimulation(nominal, &section(config));
+      ADD_FAILURE() << "no error for:\n" << text;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+    }
+  }
+}
+
+// PD control with inverse-dynamics feed-forward (with friction) from the nominal model
+// along a 2 s cosine on every joint: a plant with 10 % heavier links tracks worse than the nominal
+// plant, which the controller's model cancels.
+double trackingError(ManipulatorSimulation& sim, const ManipulatorModel& controllerModel) {
+  const int n = controllerModel.getNumberOfJoints();
+  ManipulatorData data(controllerModel);
+  DynamicsOptions options;
+  options.motorInertia = true;
+  options.friction = true;
+  const JointVector q0 = controllerModel.getHomePosition();
+  const JointVector m = massMatrix(controllerModel, data, q0, true).diagonal();
+  sim.setState(q0, JointVector::Zero(n));
+  double worst = 0;
+  JointVector qd(n), vd(n), ad(n);
+  for (int k = 0; k < 2500; ++k) {
+    const double t = k * 1e-3, w = std::acos(-1.0);
+    for (int i = 0; i < n; ++i) {
+      const double a = t < 2 ? 0.1 : 0;
+      qd(i) = q0(i) + a * (1 - std::cos(w * t));
+      vd(i) = a * w * std::sin(w * t);
+      ad(i) = a * w * w * std::cos(w * t);
+    }
+    const JointVector& q = sim.getPosition();
+    const JointVector& v = sim.getVelocity();
+    worst = std::max(worst, (qd - q).cwiseAbs().maxCoeff());
+    const JointVector ff = inverseDynamics(controllerModel, data, q, vd, ad, options);
+    JointVector tau = ff;
+    for (int i = 0; i < n; ++i) tau(i) += m(i) * (625 * (qd(i) - q(i)) + 50 * (vd(i) - v(i)));
+    sim.step(tau, 1e-3);
+  }
+  return worst;
+}
+
+TEST(SimulationPlant, HeavierLinksTrackWorseUnderTheNominalController) {
+  Puma560Model nominal;
+  const double massBefore = nominal.getLink(2).mass;
+  ManipulatorSimulation same(nominal);
+  const double e0 = trackingError(same, nominal);
+  const Configuration config = Configuration::parse("[puma]\nclass Puma560\nsimMassScale 1.1\nsimInertiaScale 1.1\n", "rp.cfg");
+  const auto heavy = makeSimulation(nominal, &section(config));
+  const double e1 = trackingError(*heavy, nominal);
+  std::printf("  largest tracking error: nominal plant %.3g mrad, 10%% heavier links %.3g mrad\n", 1e3 * e0, 1e3 * e1);
+  EXPECT_GT(e1, 1.5 * e0);
+  EXPECT_EQ(nominal.getLink(2).mass, massBefore);
+}
+
+// Figure 23 of the paper: a real and a simulated Puma; in rp.cfg the simulated one gets a plant
+// of its own. Through DefaultManipulator: its model (the controller's) stays nominal, the plant
+// starts where rp.cfg puts it and deviates.
+using SimulationPlantArm = test::SimulatedArmTest;
+TEST_F(SimulationPlantArm, DefaultManipulatorTakesItsPlantFromRpCfg) {
+  RoboticPlatform::setConfiguration(Configuration::parse(
+      "[pumaSimulated]\nclass Puma560\nsimMassScale 1.1\nsimInitialPosition 0 30 -60 0 10 0\n"
+      "simCountsPerRadian 1000\n", "rp.cfg"));
+  Puma560 arm("pumaSimulated");
+  const Puma560Model fresh;
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(arm.getModel().getLink(i).mass, fresh.getLink(i).mass);
+  const double deg = std::acos(-1.0) / 180;
+  // Where rp.cfg puts it, as 1000-count-per-radian encoders read it.
+  const JointVector q = arm.getJointPosition();
+  EXPECT_EQ(q(1), std::floor(30 * deg * 1000) / 1000);
+  EXPECT_EQ(q(2), std::floor(-60 * deg * 1000) / 1000);
+  EXPECT_EQ(q(4), std::floor(10 * deg * 1000) / 1000);
+  EXPECT_NE(q(1), 30 * deg);
+  // Running, the readings stay on the encoder's grid.
+  ASSERT_TRUE(arm.waitForCycles(50));
+  const JointVector later = arm.getJointPosition();
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(std::round(later(i) * 1000), later(i) * 1000, 1e-6) << "joint " << i + 1;
+}
+
+// ---- Real time ---------------------------------------------------------------------------------
+
+TEST(SimulationRealTime, SteppingDoesNotAllocate) {
+  Puma560Model nominal;
+  const Configuration config = Configuration::parse(
+      "[puma]\nclass Puma560\nsimMassScale 1.1\nsimCountsPerRadian 2000\nsimSensorDelay 2\n", "rp.cfg");
+  for (SimulationIntegrator integrator : {SimulationIntegrator::Euler, SimulationIntegrator::RK4}) {
+    const auto sim = makeSimulation(nominal, &section(config));
+    sim->setIntegrator(integrator);
+    JointVector q = nominal.getHomePosition(), tau = JointVector::Zero(6);
+    q(1) = nominal.getPositionMax()(1) - 1e-3;
+    JointVector qd = JointVector::Zero(6);
+    qd(1) = 1;
+    sim->setState(q, qd);  // into a stop: sub-steps, implicit stop, friction
+    Vector<6> push;
+    push(0) = 5;
+    sim->setExternalWrench(push);
+    test::AllocationGuard guard;
+    for (int k = 0; k < 200; ++k) {
+      sim->setBrakes(k > 100);
+      sim->step(tau, 1e-3);
+    }
+    EXPECT_EQ(guard.count(), 0u);
+    EXPECT_GT(sim->getLastSubsteps(), 0);
+  }
+}
+
+}  // namespace
+}  // namespace rp
