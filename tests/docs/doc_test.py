@@ -17,11 +17,13 @@ Like Rust's doctests, the text users copy from is what CI runs. Each block is on
                                 tree's; exit status 0.
                                 <!-- doc-test: server -->: each command must still run after 2 s
                                 and end with status 0 on SIGTERM; `rp.cfg above` in the annotation:
-                                the page's last rp.cfg block above is the folder's rp.cfg
+                                the page's last rp.cfg block above is the folder's rp.cfg;
+                                <!-- doc-test: script -->: the block runs as one bash script
+                                (set -euo pipefail) that must end with status 0
   ``` (rp.cfg: starts with [name]) written to rp.cfg and checked with `rp-objects -sim -config`
                                 (exit status 0); <!-- doc-test: rp.cfg FILE... --> copies FILEs
                                 (source-tree paths, `SRC:NAME` to rename) next to it
-  ``` output sample             <!-- doc-test: output [status=N] COMMAND [;; COMMAND...] -->: each
+  ``` output sample             <!-- doc-test: output [rp.cfg above] [status=N] COMMAND [;; ...] -->: each
                                 command must end with status N (default 0) and every line of the
                                 block must match a line it printed; numbers may differ, `...`
                                 stands for anything
@@ -277,6 +279,16 @@ class DocTest:
         os.symlink(os.path.join(self.src, "tests"), os.path.join(d, "tests"))  # fixtures of output samples
         os.makedirs(os.path.join(d, "docs", "images", "trajectories"))
 
+    def write_rpcfg_above(self, b, blocks, d):
+        """Writes the last rp.cfg block above `b` on its page to d/rp.cfg; false if there is none."""
+        above = [o for o in blocks if o.page == b.page and o.line < b.line and o.lang == "" and
+                 re.match(r"^\s*\[[A-Za-z0-9_-]+\]", o.body.lstrip("\n"))]
+        if not above:
+            self.fail(b, "no rp.cfg block above it on its page")
+            return False
+        open(os.path.join(d, "rp.cfg"), "w", encoding="utf-8").write(above[-1].body + "\n")
+        return True
+
     def check_sh(self, b, blocks):
         d = self.scratch(b)
         self.link_trees(d)
@@ -284,13 +296,16 @@ class DocTest:
         if not commands:
             self.fail(b, "a sh block without commands")
         ann = b.annotation or ""
-        if "rp.cfg above" in ann:
-            above = [o for o in blocks if o.page == b.page and o.line < b.line and o.lang == "" and
-                     re.match(r"^\s*\[[A-Za-z0-9_-]+\]", o.body.lstrip("\n"))]
-            if not above:
-                self.fail(b, "no rp.cfg block above it on its page")
-                return
-            open(os.path.join(d, "rp.cfg"), "w", encoding="utf-8").write(above[-1].body + "\n")
+        if "rp.cfg above" in ann and not self.write_rpcfg_above(b, blocks, d):
+            return
+        if ann.startswith("script"):  # the whole block as one bash script, stopping at the first error
+            rc, out, secs = run("set -euo pipefail\n" + b.body, d, self.env, 120, shell=True)
+            self.count("script")
+            if rc != 0:
+                self.fail(b, f"the script exited with {rc}:\n{out[-3000:]}")
+            else:
+                print(f"ok   {b.where()}: script ({secs:.1f} s)", flush=True)
+            return
         if ann.startswith("server"):
             for c in commands:
                 self.count("server command")
@@ -336,13 +351,17 @@ class DocTest:
         else:
             print(f"ok   {b.where()}: rp.cfg accepted by rp-objects", flush=True)
 
-    def check_output(self, b, spec):
+    def check_output(self, b, spec, blocks):
         status = 0
+        d = self.scratch(b)
+        self.link_trees(d)
+        if spec.startswith("rp.cfg above"):
+            if not self.write_rpcfg_above(b, blocks, d):
+                return
+            spec = spec[len("rp.cfg above"):].strip()
         m = re.match(r"status=(\d+)\s+(.*)", spec)
         if m:
             status, spec = int(m.group(1)), m.group(2)
-        d = self.scratch(b)
-        self.link_trees(d)
         printed = []
         for c in [c.strip() for c in spec.split(";;")]:
             rc, out, _ = run(c, d, self.env, 300, shell=True)
@@ -380,7 +399,7 @@ class DocTest:
             if b.lang == "sh":
                 self.check_sh(b, blocks)
             elif b.lang == "" and ann.startswith("output"):
-                self.check_output(b, ann[len("output"):].strip())
+                self.check_output(b, ann[len("output"):].strip(), blocks)
             elif b.lang == "" and re.match(r"^\s*\[[A-Za-z0-9_-]+\]", b.body.lstrip("\n")) and \
                     (ann == "" or ann.startswith("rp.cfg")):
                 self.check_rpcfg(b, ann.split()[1:])
