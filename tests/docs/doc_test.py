@@ -17,7 +17,10 @@ Like Rust's doctests, the text users copy from is what CI runs. Each block is on
                                 tree's; exit status 0.
                                 <!-- doc-test: server -->: each command must still run after 2 s
                                 and end with status 0 on SIGTERM; `rp.cfg above` in the annotation:
-                                the page's last rp.cfg block above is the folder's rp.cfg;
+                                the page's last rp.cfg block above is the folder's rp.cfg. A
+                                command whose comment starts with a quoted text (`# "..."` or
+                                `# prints "..."`) must print a line matching it (numbers may
+                                differ; words in capitals, such as PORT, stand for any word);
                                 <!-- doc-test: script -->: the block runs as one bash script
                                 (set -euo pipefail) that must end with status 0
   ``` (rp.cfg: starts with [name]) written to rp.cfg and checked with `rp-objects -sim -config`
@@ -102,7 +105,9 @@ def run(cmd, cwd, env, timeout, shell=False):
 
 
 def shell_commands(body):
-    """The command lines of a sh block: continuations joined, comments and blank lines dropped."""
+    """The command lines of a sh block: continuations joined, comments and blank lines dropped.
+    Returns (command, sample) pairs: `sample` is the quoted text of a trailing comment that starts
+    with a quoted string (`# "gripper: Close done"` or `# prints "netft 127.0.0.1:PORT"`), else None."""
     commands, current = [], ""
     for raw in body.split("\n"):
         line = raw.rstrip()
@@ -122,17 +127,23 @@ def shell_commands(body):
             elif ch == "#" and (idx == 0 or current[idx - 1] in " \t"):
                 break
             out += ch
-        commands.append(out.strip())
+        comment = current[len(out):]
+        m = re.match(r'#\s*(?:prints\s+)?"([^"]+)"', comment)
+        commands.append((out.strip(), m.group(1) if m else None))
         current = ""
     return commands
 
 
-def line_pattern(doc_line):
-    """A regular expression for a line of an output sample: numbers may differ, `...` is anything."""
+def line_pattern(doc_line, placeholders=False):
+    """A regular expression for a line of an output sample: numbers may differ, `...` is anything
+    (and with `placeholders`, a word in capitals such as PORT or N stands for any word)."""
     pattern = ""
-    for token in re.split(r"(\.\.\.|-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)", doc_line.strip()):
+    split = r"(\.\.\.|-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?" + (r"|\b[A-Z]{1,}\b)" if placeholders else ")")
+    for token in re.split(split, doc_line.strip()):
         if token == "...":
             pattern += ".*"
+        elif placeholders and re.fullmatch(r"[A-Z]+", token or ""):
+            pattern += r"\S+"
         elif re.fullmatch(r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?", token or "x"):
             pattern += r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
         else:
@@ -298,6 +309,8 @@ class DocTest:
         ann = b.annotation or ""
         if "rp.cfg above" in ann and not self.write_rpcfg_above(b, blocks, d):
             return
+        samples = {c: sample for c, sample in commands}
+        commands = [c for c, _ in commands]
         if ann.startswith("script"):  # the whole block as one bash script, stopping at the first error
             rc, out, secs = run("set -euo pipefail\n" + b.body, d, self.env, 120, shell=True)
             self.count("script")
@@ -333,10 +346,13 @@ class DocTest:
         for c in commands:
             rc, out, secs = run(c, d, self.env, 120, shell=True)
             self.count("shell command")
+            sample = samples.get(c)
             if rc != 0:
                 self.fail(b, f"`{c}` exited with {rc}:\n{out[-3000:]}")
+            elif sample and not any(line_pattern(sample, True).fullmatch(l.strip()) for l in out.split("\n")):
+                self.fail(b, f"`{c}` did not print \"{sample}\" (its comment says so); it printed:\n{out[-3000:]}")
             else:
-                print(f"ok   {b.where()}: `{c}` ({secs:.1f} s)", flush=True)
+                print(f"ok   {b.where()}: `{c}` ({secs:.1f} s)" + (f", printed \"{sample}\"" if sample else ""), flush=True)
 
     def check_rpcfg(self, b, files):
         d = self.scratch(b)
