@@ -4,7 +4,8 @@
 //   rp-device [-config FILE] [-sim|-nosim] NAME COMMAND|read
 //
 // Examples: rp-device gripper Close      rp-device -config cell.cfg ftsensor read
-// The object uses its hardware unless -sim is given or its rp.cfg section says simulationMode on.
+// As in every program, the object simulates unless -nosim is given or its rp.cfg section says
+// simulationMode off (then it uses its hardware); stderr says when it simulates.
 // Exit status: 0 done; 1 device error (the object's error status is printed); 2 configuration
 // or usage error (bad switch, bad rp.cfg, unknown object, unknown command).
 #include <iostream>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "rp/core/ObjectManager.hpp"
+#include "rp/core/PhysicalObject.hpp"
 #include "rp/core/RoboticPlatform.hpp"
 
 namespace {
@@ -20,6 +22,7 @@ constexpr const char* kUsage =
     "usage: rp-device [-config FILE] [-sim|-nosim] NAME COMMAND|read\n"
     "  runs the interactive command COMMAND of the rp.cfg object NAME (e.g. rp-device gripper Close),\n"
     "  or prints its readings as JSON (rp-device ftsensor read)\n"
+    "  the object simulates unless -nosim is given or its section says simulationMode off\n"
     "  exit status: 0 done, 1 device error, 2 configuration or usage error\n";
 
 std::string commandList(const rp::RoboticObject& object) {
@@ -43,7 +46,7 @@ int deviceError(const rp::RoboticObject& object) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> positional;
-  bool simulate = false;
+  int simulate = -1;  // -1: as every program, simulated unless the section says simulationMode off
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "-config") {
@@ -53,9 +56,9 @@ int main(int argc, char** argv) {
       }
       rp::RoboticPlatform::setConfigurationFileName(argv[++i]);
     } else if (arg == "-sim") {
-      simulate = true;
+      simulate = 1;
     } else if (arg == "-nosim") {
-      simulate = false;
+      simulate = 0;
     } else if (arg == "-h" || arg == "-help" || arg == "--help") {
       std::cout << kUsage;
       return 0;
@@ -72,14 +75,16 @@ int main(int argc, char** argv) {
   }
   const std::string& name = positional[0];
   const std::string& command = positional[1];
-  if (simulate) rp::RoboticPlatform::setSimulationModeOn();
-  else rp::RoboticPlatform::setSimulationModeOff();
+  if (simulate == 1) rp::RoboticPlatform::setSimulationModeOn();  // forces every object
+  else if (simulate == 0) rp::RoboticPlatform::setSimulationModeOff();
 
   rp::ObjectManager om;
   int status = 0;
   try {
     rp::RoboticPlatform::loadConfiguration();
     rp::RoboticObject* object = om.createObject(name);
+    if (auto* physical = dynamic_cast<rp::PhysicalObject*>(object); physical && physical->isSimulationModeOn())
+      std::cerr << "rp-device: " << name << " is simulated (-nosim or 'simulationMode off' use its hardware)\n";
     if (object->getErrorCode() != 0) {
       status = deviceError(*object);
     } else if (command == "read") {

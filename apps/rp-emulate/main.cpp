@@ -58,6 +58,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string device = argv[1];
+  if (device == "--help" || device == "-help" || device == "-h") {
+    std::cout << kUsage;
+    return 0;
+  }
   double duration = 0;
   ModbusEmulator::Config modbus;
   BarrettHandEmulator::Config hand;

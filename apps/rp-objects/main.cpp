@@ -1,20 +1,39 @@
 // rp-objects: creates every object rp.cfg describes, prints name, class and settings, shuts them
 // down and exits 0; on a configuration error prints FILE:LINE: message and exits 2.
+// rp-objects --settings [CLASS]: prints the settings reference of every registered class (or of
+// CLASS) from the classes' own setting schemas, as Markdown (docs/settings.md holds the same).
 #include <cstdio>
 #include <exception>
 #include <iostream>
 #include <string>
 #include <vector>
 
+#include "SettingsReference.hpp"
 #include "rp/core/Core.hpp"
 
 int main(int argc, char** argv) {
   rp::RoboticPlatform::setGuiOff();
   rp::RoboticPlatform::init(argc, argv,
                             "rp-objects creates every object of the configuration file, lists them and shuts them "
-                            "down: the configuration checker.");
+                            "down: the configuration checker.\n"
+                            "rp-objects --settings [CLASS] prints the settings every registered class (or CLASS) "
+                            "accepts in rp.cfg: type, unit, range, default and meaning.");
+  if (argc > 1 && std::string(argv[1]) == "--settings") {
+    if (argc > 3) {
+      std::cerr << "rp-objects: unexpected argument '" << argv[3] << "' (usage: rp-objects --settings [CLASS])\n";
+      return 2;
+    }
+    const std::string className = argc == 3 ? argv[2] : "";
+    if (!rp::apps::printSettingsReference(std::cout, className)) {
+      std::cerr << "rp-objects: no class '" << className << "' (known: " << rp::TypeDatabase::instance().knownNames()
+                << ")\n";
+      return 2;
+    }
+    return 0;
+  }
   if (argc > 1) {
-    std::cerr << "rp-objects: unexpected argument '" << argv[1] << "' (usage: rp-objects [-config FILE])\n";
+    std::cerr << "rp-objects: unexpected argument '" << argv[1]
+              << "' (usage: rp-objects [-config FILE] or rp-objects --settings [CLASS])\n";
     return 2;
   }
   rp::ObjectManager om;

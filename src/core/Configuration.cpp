@@ -257,12 +257,24 @@ void SettingSchema::add(const SettingSpec& spec) {
 
 void SettingSchema::addNumbers(const std::string& name, int count, const std::string& unit,
                                const std::string& description) {
-  add(SettingSpec{name, SettingKind::Number, count, count, {}, unit, description});
+  SettingSpec spec;
+  spec.name = name;
+  spec.minValues = spec.maxValues = count;
+  spec.unit = unit;
+  spec.description = description;
+  add(spec);
 }
 
 void SettingSchema::addNumbers(const std::string& name, int count, const std::string& unit,
                                const std::string& description, double minValue, double maxValue) {
-  add(SettingSpec{name, SettingKind::Number, count, count, {}, unit, description, minValue, maxValue});
+  SettingSpec spec;
+  spec.name = name;
+  spec.minValues = spec.maxValues = count;
+  spec.unit = unit;
+  spec.description = description;
+  spec.minValue = minValue;
+  spec.maxValue = maxValue;
+  add(spec);
 }
 
 void SettingSchema::addInteger(const std::string& name, const std::string& description) {
@@ -271,17 +283,40 @@ void SettingSchema::addInteger(const std::string& name, const std::string& descr
 
 void SettingSchema::addInteger(const std::string& name, const std::string& description, long long minValue,
                                long long maxValue) {
-  add(SettingSpec{name, SettingKind::Integer, 1, 1, {}, "", description, static_cast<double>(minValue),
-                  static_cast<double>(maxValue)});
+  SettingSpec spec;
+  spec.name = name;
+  spec.kind = SettingKind::Integer;
+  spec.description = description;
+  spec.minValue = static_cast<double>(minValue);
+  spec.maxValue = static_cast<double>(maxValue);
+  add(spec);
 }
 
 void SettingSchema::addWord(const std::string& name, const std::string& description) {
-  add(SettingSpec{name, SettingKind::Word, 1, 1, {}, "", description});
+  SettingSpec spec;
+  spec.name = name;
+  spec.kind = SettingKind::Word;
+  spec.description = description;
+  add(spec);
 }
 
 void SettingSchema::addChoice(const std::string& name, const std::vector<std::string>& choices,
                               const std::string& description) {
-  add(SettingSpec{name, SettingKind::Choice, 1, 1, choices, "", description});
+  SettingSpec spec;
+  spec.name = name;
+  spec.kind = SettingKind::Choice;
+  spec.choices = choices;
+  spec.description = description;
+  add(spec);
+}
+
+void SettingSchema::setDefault(const std::string& name, const std::string& value) {
+  for (auto& s : specs_)
+    if (s.name == name) {
+      s.defaultValue = value;
+      return;
+    }
+  throw std::logic_error("SettingSchema::setDefault: setting '" + name + "' is not declared");
 }
 
 const SettingSpec* SettingSchema::find(const std::string& name) const {

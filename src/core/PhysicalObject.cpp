@@ -67,6 +67,10 @@ void PhysicalObject::declareSettings(SettingSchema& schema) {
   schema.addNumbers("orientation", 3, "deg", "roll pitch yaw", -360, 360);
   schema.addChoice("simulationMode", {"on", "off"}, "simulate instead of using the hardware");
   schema.addChoice("display", {"off", "solid", "wireframe"}, "how the Scene Viewer shows the object");
+  schema.setDefault("position", "0 0 0");
+  schema.setDefault("orientation", "0 0 0");
+  schema.setDefault("simulationMode", "the -sim/-nosim switch");
+  schema.setDefault("display", "solid");
 }
 
 Model3D PhysicalObject::get3DModel() const {

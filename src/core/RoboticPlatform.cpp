@@ -86,7 +86,9 @@ std::string RoboticPlatform::usage() {
          "  -gui-port <n>      its TCP port (default 7070 or the next free one; 0: any free port)\n"
          "  -gui-token <text>  token pages must present (generated when the address is not loopback)\n"
          "  -config <file>     global configuration file (default: rp.cfg)\n"
-         "  -qmotor            open the tuning window\n"
+         "  -qmotor            print the URL of the QMotor window (live plots and tuning in the\n"
+         "                     browser); with the Scene Viewer off (-nogui) there is no window\n"
+         "                     and a warning says so\n"
          "  -log <file>        log every log variable of every control program to one CSV file\n"
          "  -simclock          run control programs on a simulated clock, as fast as possible\n"
          "  --help             print this text and exit\n"
@@ -225,6 +227,8 @@ void RoboticPlatform::init(int& argc, char** argv, const std::string& programUsa
     starter = s.guiStarter;
   }
   if (isGuiOn() && starter) starter();
+  else if (isQMotorOn())
+    std::cerr << "rp: -qmotor: no QMotor window, the Scene Viewer is off (-nogui)" << std::endl;
 }
 
 bool RoboticPlatform::isInitialized() { return state().initialized.load(); }

@@ -43,11 +43,16 @@ AtiFTSensor::~AtiFTSensor() {
 
 void AtiFTSensor::declareSettings(SettingSchema& schema) {
   ForceTorqueSensor::declareSettings(schema);
-  schema.addWord("address", "Net F/T IPv4 address (default 127.0.0.1)");
-  schema.addInteger("port", "RDT UDP port (default 49152)");
-  schema.addNumbers("countsPerForce", 1, "counts/N", "force calibration (the sensor's cfgcpf)");
-  schema.addNumbers("countsPerTorque", 1, "counts/(N m)", "torque calibration (the sensor's cfgcpt)");
-  schema.addInteger("timeout", "how long a reading waits for a record [ms] (default 100)");
+  schema.addWord("address", "Net F/T IPv4 address");
+  schema.addInteger("port", "RDT UDP port", 1, 65535);
+  schema.addNumbers("countsPerForce", 1, "counts/N", "force calibration (the sensor's cfgcpf), positive");
+  schema.addNumbers("countsPerTorque", 1, "counts/(N m)", "torque calibration (the sensor's cfgcpt), positive");
+  schema.addInteger("timeout", "how long a reading waits for a record [ms]", 1, 60000);
+  schema.setDefault("address", "127.0.0.1");
+  schema.setDefault("port", "49152");
+  schema.setDefault("countsPerForce", "1000000");
+  schema.setDefault("countsPerTorque", "1000000");
+  schema.setDefault("timeout", "100");
 }
 
 IoStatus AtiFTSensor::ensureStreaming() noexcept {

@@ -44,9 +44,13 @@ BarrettHand::~BarrettHand() { withdrawObject(); }  // first: other threads keep 
 void BarrettHand::declareSettings(SettingSchema& schema) {
   Gripper::declareSettings(schema);
   schema.addWord("port", "serial port of the hand, e.g. /dev/ttyS0");
-  schema.addInteger("baud", "baud rate (default 9600)");
-  schema.addInteger("timeout", "how long to wait for the prompt [ms] (default 1000)");
-  schema.addInteger("motionTimeout", "the same for HI, GO and GC [ms] (default 10000)");
+  schema.addInteger("baud", "baud rate: 9600, 19200, 38400, 57600 or 115200", 1, 115200);
+  schema.addInteger("timeout", "how long to wait for the prompt [ms]", 1, 600000);
+  schema.addInteger("motionTimeout", "the same for HI, GO and GC [ms]", 1, 600000);
+  schema.setDefault("port", "(required)");
+  schema.setDefault("baud", "9600");
+  schema.setDefault("timeout", "1000");
+  schema.setDefault("motionTimeout", "10000");
 }
 
 bool BarrettHand::check(IoStatus status) {

@@ -11,11 +11,19 @@ void declareTwoLineBoardSettings(SettingSchema& schema, const char* lineA, const
   schema.addChoice("board", {"simulated", "modbus", "hwserver"}, "the I/O board that drives the lines");
   schema.addInteger(lineA, "digital output line (modbus: coil address)");
   schema.addInteger(lineB, "digital output line (modbus: coil address)");
-  schema.addWord("address", "Modbus TCP server address (default 127.0.0.1)");
-  schema.addInteger("port", "Modbus TCP port (default 502)");
-  schema.addInteger("unitId", "Modbus unit id (default 1)");
-  schema.addInteger("timeout", "Modbus response timeout [ms] (default 200)");
+  schema.addWord("address", "Modbus TCP server address");
+  schema.addInteger("port", "Modbus TCP port", 1, 65535);
+  schema.addInteger("unitId", "Modbus unit id", 0, 247);
+  schema.addInteger("timeout", "Modbus response timeout [ms]", 1, 60000);
   schema.addWord("server", "hardware server name (rp-hwserver -name NAME)");
+  schema.setDefault("board", "(none: the lines are not driven, commands report an error)");
+  schema.setDefault(lineA, "(required with board)");
+  schema.setDefault(lineB, "(required with board)");
+  schema.setDefault("address", "127.0.0.1");
+  schema.setDefault("port", "502");
+  schema.setDefault("unitId", "1");
+  schema.setDefault("timeout", "200");
+  schema.setDefault("server", "(required with board hwserver)");
 }
 
 namespace {

@@ -1,6 +1,7 @@
 #include "rp/effector/ForceTorqueSensor.hpp"
 
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "Json.hpp"
@@ -37,9 +38,12 @@ ForceTorqueSensor::~ForceTorqueSensor() = default;
 
 void ForceTorqueSensor::declareSettings(SettingSchema& schema) {
   PhysicalObject::declareSettings(schema);
-  schema.addNumbers("payload", 1, "kg", "simulated payload mass");
+  schema.addNumbers("payload", 1, "kg", "simulated payload mass", 0, std::numeric_limits<double>::max());
   schema.addNumbers("payloadCenter", 3, "mm", "simulated payload centre of mass in the sensor frame");
-  schema.addInteger("maxMissedCycles", "servo cycles without a new reading before the sensor is in error");
+  schema.addInteger("maxMissedCycles", "servo cycles without a new reading before the sensor is in error", 1, 1000000);
+  schema.setDefault("payload", "0");
+  schema.setDefault("payloadCenter", "0 0 0");
+  schema.setDefault("maxMissedCycles", "50");
 }
 
 void ForceTorqueSensor::setSimulatedWrench(const Vector<3>& force, const Vector<3>& torque) {

@@ -1,6 +1,7 @@
 #include "rp/effector/Gripper.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <mutex>
 #include <sstream>
 
@@ -36,7 +37,8 @@ Gripper::~Gripper() = default;
 
 void Gripper::declareSettings(SettingSchema& schema) {
   PhysicalObject::declareSettings(schema);
-  schema.addNumbers("graspRange", 1, "mm", "how close a graspable object must be (simulation)");
+  schema.addNumbers("graspRange", 1, "mm", "how close a graspable object must be (simulation)", 0,
+                    std::numeric_limits<double>::max());
   SettingSpec graspable;
   graspable.name = "graspable";
   graspable.kind = SettingKind::Word;
@@ -44,6 +46,8 @@ void Gripper::declareSettings(SettingSchema& schema) {
   graspable.maxValues = 64;
   graspable.description = "names of the objects the simulated gripper can pick up";
   schema.add(graspable);
+  schema.setDefault("graspRange", "50");
+  schema.setDefault("graspable", "(none: only objects added in code)");
 }
 
 const char* Gripper::stateName(State state) noexcept {

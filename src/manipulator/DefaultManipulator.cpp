@@ -473,6 +473,8 @@ void DefaultManipulator::declareSettings(SettingSchema& schema) {
   schema.addWord("hwserver", "name of the hardware server the arm is wired to");
   schema.addNumbers("countsPerRadian", 1, "counts/rad", "encoder counts per joint radian");
   ManipulatorSimulation::declareSettings(schema);
+  schema.setDefault("hwserver", "(none: no hardware, the arm stays unpowered unless simulated)");
+  schema.setDefault("countsPerRadian", "20000");
 }
 
 bool DefaultManipulator::readHardware(double elapsed) {

@@ -26,6 +26,7 @@ Puma560::~Puma560() { stopControlLoop(); }
 void Puma560::declareSettings(SettingSchema& schema) {
   DefaultManipulator::declareSettings(schema);
   schema.addNumbers("pedestalHeight", 1, "m", "height of the shoulder above the mounting surface");
+  schema.setDefault("pedestalHeight", "0.67183");
 }
 
 }  // namespace rp

@@ -57,6 +57,8 @@ void UrdfManipulator::declareSettings(SettingSchema& schema) {
   DefaultManipulator::declareSettings(schema);
   schema.addWord("urdf", "URDF file of the arm");
   schema.addWord("tip", "last link of the chain");
+  schema.setDefault("urdf", "the constructor's argument");
+  schema.setDefault("tip", "the constructor's argument");
 }
 
 }  // namespace rp

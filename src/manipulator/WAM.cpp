@@ -32,6 +32,7 @@ WAM::~WAM() { stopControlLoop(); }
 void WAM::declareSettings(SettingSchema& schema) {
   DefaultManipulator::declareSettings(schema);
   schema.addChoice("links", {"4", "7"}, "number of links: the 4-DOF arm or the 7-DOF arm with wrist");
+  schema.setDefault("links", "7 (the constructor's argument)");
 }
 
 }  // namespace rp

@@ -369,5 +369,18 @@ TEST(SettingSchema, DeclarationsAndKnownNames) {
   EXPECT_EQ(s.knownNames(), "display, orientation, position, qmotorConfig, simulationMode");
 }
 
+TEST(SettingSchema, DefaultsForTheReference) {
+  SettingSchema s;
+  s.addInteger("port", "TCP port", 1, 65535);
+  EXPECT_EQ(s.find("port")->defaultValue, "");
+  s.setDefault("port", "502");
+  EXPECT_EQ(s.find("port")->defaultValue, "502");
+  EXPECT_EQ(s.find("port")->minValue, 1);
+  EXPECT_EQ(s.find("port")->maxValue, 65535);
+  EXPECT_THROW(s.setDefault("prot", "502"), std::logic_error);  // a typo is a programming error
+  PhysicalObject::declareSettings(s);
+  EXPECT_EQ(s.find("display")->defaultValue, "solid");
+}
+
 }  // namespace
 }  // namespace rp

@@ -57,6 +57,29 @@ TEST(RpObjects, ConfigurationErrorExits2WithFileAndLine) {
   EXPECT_NE(extra.output.find("none.cfg: cannot read the file: No such file or directory"), std::string::npos);
 }
 
+TEST(RpObjects, SettingsPrintsEachClassSchemaWithPluginClasses) {
+  auto dir = test::scratchDirectory("rpobjects_settings");
+  test::writeFile(dir / "rp.cfg", cellConfig());
+  const std::string cfg = (dir / "rp.cfg").string();
+  Result one = run(std::string(RP_OBJECTS) + " -config " + cfg + " --settings BarrettHand");
+  EXPECT_EQ(one.status, 0) << one.output;
+  EXPECT_NE(one.output.find("### BarrettHand\n"), std::string::npos) << one.output;
+  EXPECT_NE(one.output.find("| `baud` | integer |  | 1 .. 115200 | 9600 | baud rate: 9600, 19200, 38400, 57600 or 115200 |\n"),
+            std::string::npos) << one.output;
+  EXPECT_NE(one.output.find("| `display` | choice |  | `off`, `solid`, `wireframe` | solid |"), std::string::npos)
+      << one.output;
+  EXPECT_EQ(one.output.find("### Puma560"), std::string::npos) << "only the class asked for";
+  Result all = run(std::string(RP_OBJECTS) + " -config " + cfg + " --settings");
+  EXPECT_EQ(all.status, 0) << all.output;
+  EXPECT_NE(all.output.find("### PluginArm\n"), std::string::npos) << "the plugin's class: " << all.output;
+  EXPECT_NE(all.output.find("| `reach` |"), std::string::npos) << all.output;
+  EXPECT_NE(all.output.find("### DefaultTrajectoryGenerator\n\nNo settings besides `class` and `qmotorConfig`."),
+            std::string::npos) << all.output;
+  Result unknown = run(std::string(RP_OBJECTS) + " --settings Nope");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_NE(unknown.output.find("rp-objects: no class 'Nope' (known: "), std::string::npos) << unknown.output;
+}
+
 TEST(Plugin, ClassesFromAPluginAreCreatedByName) {
   auto dir = test::scratchDirectory("plugin");
   test::writeFile(dir / "rp.cfg", cellConfig());

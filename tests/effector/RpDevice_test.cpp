@@ -30,7 +30,7 @@ class RpDevice : public ::testing::Test {
   }
   // Runs rp-device and returns (exit status, first line of stdout).
   std::pair<int, std::string> run(const std::vector<std::string>& args) {
-    std::vector<std::string> argv{RP_DEVICE_PATH};
+    std::vector<std::string> argv{RP_DEVICE_PATH, "-nosim"};  // the hardware: here the emulators
     argv.insert(argv.end(), args.begin(), args.end());
     test::ChildProcess child(argv);
     const std::string line = child.readLine(30000).value_or("");
@@ -38,7 +38,7 @@ class RpDevice : public ::testing::Test {
   }
   // Runs rp-device with stderr on the same pipe: (exit status, first line of stdout or stderr).
   std::pair<int, std::string> runMerged(const std::vector<std::string>& args) {
-    std::vector<std::string> argv{RP_DEVICE_PATH};
+    std::vector<std::string> argv{RP_DEVICE_PATH, "-nosim"};  // the hardware: here the emulators
     argv.insert(argv.end(), args.begin(), args.end());
     test::ChildProcess child(argv, true);
     const std::string line = child.readLine(30000).value_or("");
@@ -80,7 +80,7 @@ TEST_F(RpDeviceThroughHwServer, CommandIsDoneOnlyWhenTheBoardHasIt) {
   startServer(device.port(), "0,1");
   const auto cfg = writeConfig("[changer]\nclass DefaultToolChanger\nboard hwserver\nserver " + name_ +
                                "\nlockLine 0\nunlockLine 1\n");
-  test::ChildProcess child({RP_DEVICE_PATH, "-config", cfg, "changer", "Unlock"});
+  test::ChildProcess child({RP_DEVICE_PATH, "-nosim", "-config", cfg, "changer", "Unlock"});
   EXPECT_EQ(child.readLine(30000).value_or("(nothing)"), "changer: Unlock done");
   EXPECT_EQ(device.coilSwitchedOn(1), 1) << "the unlock coil was set before 'done'";
   EXPECT_EQ(device.coilSwitchedOn(0), 0);
@@ -141,6 +141,27 @@ TEST_F(RpDevice, ClosesAModbusGripper) {
   EXPECT_EQ(out, "gripper: Close done");
   EXPECT_TRUE(device.coil(1));
   EXPECT_FALSE(device.coil(0));
+}
+
+// As every program (docs/hardware.md): objects simulate unless -nosim or simulationMode off.
+TEST_F(RpDevice, SimulatesUnlessNosim) {
+  emulator::ModbusEmulator device;
+  device.start();
+  const auto cfg = writeConfig("[gripper]\nclass DefaultGripper\nboard modbus\nport " + std::to_string(device.port()) +
+                               "\nopenLine 0\ncloseLine 1\n");
+  test::ChildProcess child({RP_DEVICE_PATH, "-config", cfg, "gripper", "Close"});
+  EXPECT_EQ(child.readLine(10000).value_or("(nothing)"), "gripper: Close done");
+  EXPECT_EQ(child.wait(10000), 0);
+  EXPECT_FALSE(device.coil(1)) << "the simulated gripper reached the device";
+  const auto [status, out] = run({"-config", cfg, "gripper", "Close"});  // run() adds -nosim
+  EXPECT_EQ(status, 0);
+  EXPECT_TRUE(device.coil(1));
+  const auto cfgOff = writeConfig("[gripper]\nclass DefaultGripper\nsimulationMode off\nboard modbus\nport " +
+                                  std::to_string(device.port()) + "\nopenLine 0\ncloseLine 1\n");
+  test::ChildProcess child2({RP_DEVICE_PATH, "-config", cfgOff, "gripper", "Open"});
+  EXPECT_EQ(child2.readLine(10000).value_or("(nothing)"), "gripper: Open done");
+  EXPECT_EQ(child2.wait(10000), 0);
+  EXPECT_TRUE(device.coil(0)) << "simulationMode off: the hardware";
 }
 
 TEST_F(RpDevice, ReadsAForceTorqueSensorAsJson) {

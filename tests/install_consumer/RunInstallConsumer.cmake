@@ -19,3 +19,11 @@ endif()
 if(NOT "${out}" MATCHES "consumer: end-effector position 0.5 0.25 1")
   message(FATAL_ERROR "the consumer did not print its end-effector position")
 endif()
+# The installed copy on its own: the prefix moved elsewhere, a program run without
+# LD_LIBRARY_PATH serves the installed front end (check-relocated.sh says what it checks).
+execute_process(COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/check-relocated.sh ${prefix} ${WORK_DIR}/moved
+  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}${err}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the relocated install check failed (${rc})")
+endif()

@@ -13,6 +13,18 @@ namespace {
 
 int portOf(const std::string& line) { return std::stoi(line.substr(line.rfind(':') + 1)); }
 
+TEST(RpEmulate, HelpPrintsTheUsageAndExits0) {
+  for (const char* help : {"--help", "-h"}) {
+    test::ChildProcess emulator({RP_EMULATE_PATH, help}, true);
+    EXPECT_EQ(emulator.readLine(10000).value_or("(nothing)"), "usage: rp-emulate modbus [-port P] [-duration S]") << help;
+    EXPECT_EQ(emulator.wait(10000), 0) << help;
+  }
+  test::ChildProcess unknown({RP_EMULATE_PATH, "--frobnicate"}, true);
+  EXPECT_EQ(unknown.readLine(10000).value_or("(nothing)"),
+            "rp-emulate: unknown device '--frobnicate' (modbus, barretthand or netft)");
+  EXPECT_EQ(unknown.wait(10000), 2);
+}
+
 TEST(RpEmulate, ModbusPrintsItsPortAndCoilChanges) {
   test::ChildProcess emulator({RP_EMULATE_PATH, "modbus", "-duration", "20"});
   const auto line = emulator.readLine(30000);

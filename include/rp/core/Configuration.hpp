@@ -66,6 +66,9 @@ struct SettingSpec {
   double minValue = std::numeric_limits<double>::lowest();
   /// Largest value allowed (Number and Integer).
   double maxValue = std::numeric_limits<double>::max();
+  /// What applies when the setting is absent, as text for the settings reference
+  /// (`rp-objects --settings`, docs/settings.md), e.g. `502` or `(none: simulation only)`.
+  std::string defaultValue;
 };
 
 /// Limits on what a configuration file may hold (a file beyond them is refused with FILE:LINE).
@@ -114,6 +117,11 @@ class SettingSchema {
   /// @param[in] choices      the allowed words
   /// @param[in] description  meaning of the value
   void addChoice(const std::string& name, const std::vector<std::string>& choices, const std::string& description);
+  /// Records what applies when a declared setting is absent (shown by `rp-objects --settings`).
+  /// @param[in] name   a setting declared before
+  /// @param[in] value  the default as text, e.g. `502`
+  /// @throws std::logic_error if `name` is not declared
+  void setDefault(const std::string& name, const std::string& value);
   /// Adds a fully described setting (replaces one of the same name).
   /// @param[in] spec  the declaration
   void add(const SettingSpec& spec);

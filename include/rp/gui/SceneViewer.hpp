@@ -97,7 +97,9 @@ class SceneViewer {
   SceneViewerStatistics getStatistics() const;
 
   /// The folder of the built front end: the environment variable `RP_WEB_ROOT` if set, else the
-  /// build tree's `web/` folder compiled in, else the installed `share/roboticplatform/web`.
+  /// installed `share/roboticplatform/web` beside the loaded library (`<libdir>/../share/...`,
+  /// found at run time, so an installed prefix works wherever it is copied) if it holds an
+  /// `index.html`, else the build tree's `webroot/` compiled in.
   static std::string defaultWebRoot();
   /// Whether `address` is a loopback address (127.0.0.0/8 or ::1).
   /// @param[in] address  IP address literal
