@@ -776,6 +776,17 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
 
   std::string object;
   if (!str("object", object)) return;
+  if (type == "meshFailed") {
+    // A page could not draw a mesh the scene names: printed on stderr once per file.
+    auto shape = msg.find("shape");
+    if (shape == msg.end() || !shape->is_number_integer() || shape->get<long long>() < 0 ||
+        shape->get<long long>() > 1000000)
+      return refuse("'shape' must be a non-negative integer");
+    std::string why;
+    if (!str("message", why)) return;
+    const bool printed = scene.reportMeshFailure(object, static_cast<std::size_t>(shape->get<long long>()), why);
+    return session->sendText(json{{"type", "result"}, {"id", id}, {"ok", true}, {"reply", printed ? "printed" : ""}}.dump());
+  }
   std::function<std::string()> action;  // runs in the worker; returns the reply text; throws on failure
   if (type == "command") {
     std::string command;
@@ -846,8 +857,8 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     };
   } else {
     return refuse("unknown message type '" + type +
-                  "' (known: hello, ping, scene, command, display, setParameter, message, emergencyStop, logInfo, logging, "
-                  "logSubscribe)");
+                  "' (known: hello, ping, scene, command, display, setParameter, message, meshFailed, emergencyStop, logInfo, "
+                  "logging, logSubscribe)");
   }
 
   std::weak_ptr<WsSession> weak = session;

@@ -8,6 +8,7 @@
 
 #include "rp/core/RoboticPlatform.hpp"
 #include "rp/core/TypeDatabase.hpp"
+#include "rp/gui/UrdfVisuals.hpp"
 
 namespace rp {
 
@@ -49,10 +50,19 @@ UrdfManipulator::UrdfManipulator(const std::string& name, const std::string& urd
 
 UrdfManipulator::~UrdfManipulator() { stopControlLoop(); }
 
+std::vector<std::string> UrdfManipulator::getPackagePath() const {
+  if (const ConfigSection* section = RoboticPlatform::getConfiguration().findSection(getName()))
+    if (section->has("packagePath"))
+      return splitPackagePath(section->getWord("packagePath"),
+                              std::filesystem::path(section->fileName()).parent_path().string());
+  return {};
+}
+
 void UrdfManipulator::declareSettings(SettingSchema& schema) {
   DefaultManipulator::declareSettings(schema);
   schema.addWord("urdf", "URDF file of the arm");
   schema.addWord("tip", "last link of the chain");
+  schema.addWord("packagePath", "folders holding the packages of package:// mesh files, separated by ':'");
 }
 
 }  // namespace rp
