@@ -3,8 +3,9 @@
 
 #include <cctype>
 #include <cmath>
-#include <iostream>
 #include <cstring>
+#include <filesystem>
+#include <iostream>
 #include <set>
 
 #include "rp/core/ObjectManager.hpp"
@@ -104,11 +105,15 @@ void SceneState::loadVisuals(Entry& e) {
     reportOnce(arm->getUrdfFile(), "rp: Scene Viewer: '" + e.name + "' is drawn without its URDF visuals: " + ex.what());
     return;
   }
-  for (const UrdfVisual& v : e.urdfVisuals)
+  for (const UrdfVisual& v : e.urdfVisuals) {
+    if (!v.textureError.empty())
+      reportOnce(v.textureUri, "rp: Scene Viewer: texture " + v.textureUri + " of link '" + v.link + "' of '" + e.name +
+                                   "' (" + arm->getUrdfFile() + "): " + v.textureError + "; drawn in its colour");
     if (!v.meshError.empty())
       reportOnce(v.meshUri, "rp: Scene Viewer: mesh " + v.meshUri + " of link '" + v.link + "' of '" + e.name +
                                 "' (" + arm->getUrdfFile() + "): " + v.meshError + "; drawn " +
                                 (v.collision.empty() ? "as a placeholder" : "with its collision geometry"));
+  }
 }
 
 bool SceneState::reportOnce(const std::string& file, const std::string& what) {
@@ -122,8 +127,12 @@ bool SceneState::reportMeshFailure(const std::string& name, std::size_t shape, c
   if (file.empty()) return false;
   std::string text;  // the page's words, without control characters
   for (char c : why.substr(0, 200)) text += std::iscntrl(static_cast<unsigned char>(c)) ? ' ' : c;
-  return reportOnce(file, "rp: Scene Viewer: mesh " + file + " of '" + name + "' cannot be drawn: " + text +
-                              "; drawn with its collision geometry or a placeholder");
+  std::string ext = std::filesystem::path(file).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool image = ext == ".png" || ext == ".jpg" || ext == ".jpeg";  // a URDF texture
+  return reportOnce(file, std::string("rp: Scene Viewer: ") + (image ? "texture " : "mesh ") + file + " of '" + name +
+                              "' cannot be drawn: " + text +
+                              (image ? "; drawn in its colour" : "; drawn with its collision geometry or a placeholder"));
 }
 
 SceneState::SceneState() = default;
@@ -214,6 +223,16 @@ json SceneState::describe(Entry& e) {
           js["mesh"] = v.shape.meshFile.empty() ? v.meshUri : v.shape.meshFile;
           js["uri"] = v.meshUri;
           if (!v.meshError.empty()) js["meshError"] = v.meshError;
+        }
+        if (!v.textureUri.empty()) {
+          json texture = {{"uri", v.textureUri}};
+          if (!v.textureError.empty()) {
+            texture["error"] = v.textureError;
+          } else {
+            texture["meshShape"] = e.meshes.size();  // served as the meshes are
+            e.meshes.push_back(v.textureFile);
+          }
+          js["texture"] = std::move(texture);
         }
         json fallback = json::array();
         for (const Shape& c : v.collision) {

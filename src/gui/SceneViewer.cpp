@@ -525,7 +525,11 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
     if (file.empty() || !std::filesystem::is_regular_file(file, ec) ||
         std::filesystem::file_size(file, ec) > kMaxMeshFileBytes || ec || !readFileCapped(file, kMaxMeshFileBytes, body))
       return respond(http::status::not_found, "text/plain", "no mesh file for that shape\n", req);
-    respond(http::status::ok, "application/octet-stream", std::move(body), req);
+    // A URDF texture is an image (the page loads it as one); meshes are bytes.
+    std::string ext = std::filesystem::path(file).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const char* type = ext == ".png" ? "image/png" : ext == ".jpg" || ext == ".jpeg" ? "image/jpeg" : "application/octet-stream";
+    respond(http::status::ok, type, std::move(body), req);
   }
 
   void respond(http::status status, const std::string& type, std::string body,

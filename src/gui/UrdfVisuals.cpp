@@ -46,6 +46,13 @@ bool isDrawnFormat(const std::string& file) {
   return ext == ".stl" || ext == ".dae" || ext == ".obj" || ext == ".glb" || ext == ".gltf" || ext == ".wrl";
 }
 
+// The image formats the page draws as textures (by the file's extension, lower case).
+bool isImageFile(const std::string& file) {
+  std::string ext = std::filesystem::path(file).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+}
+
 // A URDF <geometry> as a shape (kind, size and mesh), false for a kind that is not drawn.
 bool geometryShape(const urdf::Geometry& g, const std::string& urdfFile, const std::vector<std::string>& packagePath,
                    Shape& s, std::string& uri, std::string& error) {
@@ -225,6 +232,19 @@ std::vector<UrdfVisual> readUrdfVisuals(const std::string& urdfFile, const UrdfV
           urdf::MaterialSharedPtr material = v->material;
           if (!material && !v->material_name.empty()) material = robot->getMaterial(v->material_name);
           if (material) s.color = Color{material->color.r, material->color.g, material->color.b, material->color.a};
+          if (material && !material->texture_filename.empty()) {
+            visual.textureUri = material->texture_filename;
+            std::string searched;
+            visual.textureFile = resolveMeshUri(visual.textureUri, urdfFile, visualOptions.packagePath, &searched);
+            if (visual.textureFile.empty() || visual.textureFile.rfind("http", 0) == 0) {
+              visual.textureError = visual.textureFile.empty() ? "no such file (looked in " + searched + ")"
+                                                               : "only local image files are drawn";
+              visual.textureFile.clear();
+            } else if (!isImageFile(visual.textureFile)) {
+              visual.textureError = "format not drawn (PNG and JPEG are)";
+              visual.textureFile.clear();
+            }
+          }
           visual.link = link->name;
           visual.collision = collision;
           visuals.push_back(std::move(visual));

@@ -98,6 +98,15 @@ describe('URDF meshes of a UrdfManipulator', () => {
       sensor_link: 'fallback',
     });
     checkBoxes(shapes);
+    // The hand's texture (a 4 x 4 checker board) is on its material; the forearm's missing one is not.
+    await waitInPage(page, () => window.rp.view.drawnShapes('arm').every((s) => s.texture !== 'loading'));
+    assert.deepEqual(await page.evaluate(() => {
+      const d = window.rp.view.drawnShapes('arm');
+      const hand = window.rp.view.objects.get('arm').drawn[d.findIndex((s) => s.link === 'hand_link')].objects[0];
+      let map = null;
+      hand.traverse((c) => { if (c.isMesh && c.material.map) map = [c.material.map.image.width, c.material.map.image.height]; });
+      return { textures: d.map((s) => s.texture), map };
+    }), { textures: [null, null, null, 'failed', 'drawn', null], map: [4, 4] });
 
     for (const [joint, value] of [[0, 0.7], [1, -0.5], [2, 0.8]])
       await ctx.page.evaluate(([j, v]) => window.rp.conn.message('jointmove', 'setJoint', JSON.stringify({ joint: j, value: v })), [joint, value]);
@@ -120,6 +129,7 @@ describe('URDF meshes of a UrdfManipulator', () => {
     });
     assert.match(label, /cam_link: package:\/\/rp_mesh_arm\/meshes\/broken\.dae: /);
     assert.match(label, /sensor_link: package:\/\/rp_mesh_arm\/meshes\/missing_sensor\.dae: no such file/);
+    assert.match(label, /fore_link: texture package:\/\/rp_mesh_arm\/textures\/missing_paint\.png: no such file/);
     // The label stands next to the arm, inside the view.
     const box = await page.evaluate(() => {
       const r = document.querySelector('.mesh-problems[data-object="arm"]').getBoundingClientRect();
@@ -134,6 +144,7 @@ describe('URDF meshes of a UrdfManipulator', () => {
     assert.equal(out().match(/rp: Scene Viewer: mesh \S*missing_sensor\.dae/g)?.length, 1, out());
     assert.equal(out().match(/rp: Scene Viewer: mesh \S*broken\.dae/g)?.length, 1, out());
     assert.match(out(), /missing_sensor\.dae of link 'sensor_link' of 'arm' .*no such file .*drawn with its collision geometry/);
+    assert.equal(out().match(/rp: Scene Viewer: texture \S*missing_paint\.png/g)?.length, 1, out());
     await page.close();
   });
 

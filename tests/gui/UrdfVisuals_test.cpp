@@ -163,6 +163,13 @@ TEST(UrdfVisuals, PackageMeshesFoundInTheFoldersAboveTheDescription) {
   EXPECT_EQ(visuals[0].meshUri, "package://rp_mesh_arm/meshes/base.obj");
   EXPECT_NEAR(visuals[0].shape.color.b, 0.45, 1e-6);  // the robot's material "slate"
   EXPECT_DOUBLE_EQ(visuals[3].shape.size(0), 0.001);  // the STL's scale
+  // The hand's texture is found as the meshes are; the forearm's does not exist.
+  EXPECT_EQ(visuals[4].textureUri, "package://rp_mesh_arm/textures/checker.png");
+  EXPECT_EQ(visuals[4].textureFile, (meshes.parent_path() / "textures/checker.png").string());
+  EXPECT_EQ(visuals[4].textureError, "");
+  EXPECT_EQ(visuals[3].textureFile, "");
+  EXPECT_NE(visuals[3].textureError.find("no such file"), std::string::npos) << visuals[3].textureError;
+  EXPECT_EQ(visuals[0].textureUri, "");
   for (const auto& v : visuals) EXPECT_EQ(v.meshError, v.link == "sensor_link" ? v.meshError : "") << v.link;
 }
 

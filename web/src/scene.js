@@ -224,7 +224,8 @@ export class SceneView {
 
   // For tests and the console (read only): what is drawn for each shape of object `name`: kind,
   // URDF link, frame, state ('primitive', 'loading', 'mesh', 'fallback', 'placeholder'), error,
-  // and the world-space bounding box of what is drawn for it ({ min, max }, null if nothing).
+  // texture (null: none; 'loading', 'drawn', 'failed'), and the world-space bounding box of what
+  // is drawn for it ({ min, max }, null if nothing).
   drawnShapes(name) {
     const o = this.objects.get(name);
     if (!o) return null;
@@ -233,7 +234,7 @@ export class SceneView {
       const box = new THREE.Box3();
       for (const h of d.objects) box.expandByObject(h, true);
       return {
-        kind: d.kind, link: d.link, frame: d.frame, state: d.state, error: d.error,
+        kind: d.kind, link: d.link, frame: d.frame, state: d.state, error: d.error, texture: d.texture,
         box: box.isEmpty() ? null : { min: box.min.toArray(), max: box.max.toArray() },
       };
     });
@@ -272,11 +273,11 @@ export class SceneView {
       return holder;
     };
     // A mesh (of a visual, or of a link's collision geometry) loaded into a group scaled by its size.
-    const meshGroup = (s, meshShape, onDone) => {
+    const meshGroup = (s, meshShape, onDone, mat = material(s.color)) => {
       const g = new THREE.Group();
       g.scale.set(s.size[0], s.size[1], s.size[2]);
       g.userData.object = desc.name;
-      loadMesh(g, meshUrl(desc.name, meshShape, s.mesh), s.mesh, material(s.color), materials, (error) => {
+      loadMesh(g, meshUrl(desc.name, meshShape, s.mesh), s.mesh, mat, materials, (error) => {
         if (error) this.meshes.failed++;
         else this.meshes.loaded++;
         this.refit = true;
@@ -320,8 +321,32 @@ export class SceneView {
       }
       this.refit = true;
     };
+    // A shape's material: its colour, and the URDF material's texture image (served as meshes are).
+    const shapeMaterial = (s, d) => {
+      const m = material(s.color);
+      if (!s.texture) return m;
+      const name = s.texture.uri;
+      if (s.texture.error) {
+        d.texture = 'failed';
+        problems.push({ frame: s.frame, text: `${s.link ? `${s.link}: ` : ''}texture ${name}: ${s.texture.error}` });
+        return m;
+      }
+      d.texture = 'loading';
+      new THREE.TextureLoader().load(meshUrl(desc.name, s.texture.meshShape, name), (t) => {
+        t.colorSpace = THREE.SRGBColorSpace;
+        m.map = t;
+        m.needsUpdate = true;
+        d.texture = 'drawn';
+      }, undefined, () => {
+        d.texture = 'failed';
+        problems.push({ frame: s.frame, text: `${s.link ? `${s.link}: ` : ''}texture ${name}: cannot be loaded` });
+        if (this.onMeshFailed) this.onMeshFailed(desc.name, s.texture.meshShape, 'the texture image cannot be loaded');
+      });
+      return m;
+    };
     (desc.shapes || []).forEach((s, shapeIndex) => {
-      const d = { kind: s.kind, link: s.link || null, frame: s.frame, state: 'primitive', error: null, objects: [] };
+      const d = { kind: s.kind, link: s.link || null, frame: s.frame, state: 'primitive', error: null, objects: [],
+        texture: null };
       drawn.push(d);
       if (s.kind === 'mesh' && s.meshError) {
         standIn(s, shapeIndex, s.meshError);
@@ -330,10 +355,10 @@ export class SceneView {
         const g = meshGroup(s, shapeIndex, (error) => {
           if (error) standIn(s, shapeIndex, error);
           else d.state = 'mesh';
-        });
+        }, shapeMaterial(s, d));
         d.objects.push(placed(s, g));
       } else {
-        d.objects.push(placed(s, primitive(s, material(s.color))));
+        d.objects.push(placed(s, primitive(s, shapeMaterial(s, d))));
       }
     });
     if (desc.urdfError) problems.push({ frame: 'base', text: `URDF visuals: ${desc.urdfError}` });

@@ -28,6 +28,11 @@ struct UrdfVisual {
   std::string link;       ///< name of the URDF link the visual belongs to
   std::string meshUri;    ///< a mesh's file name as the URDF gives it (empty for other shapes)
   std::string meshError;  ///< why the mesh cannot be drawn (no such file, format not drawn); empty if fine
+  /// The image file of the visual's material `<texture filename>` (absolute path of a PNG or
+  /// JPEG file found as mesh files are); empty without a texture or when it cannot be used.
+  std::string textureFile;
+  std::string textureUri;    ///< the texture's file name as the URDF gives it (empty: none)
+  std::string textureError;  ///< why the texture cannot be drawn (no such file, not PNG/JPEG); empty if fine
   /// The link's `<collision>` elements in the same frame (meshes resolved as the visuals; a mesh
   /// not found is left out): what is drawn instead of a mesh that cannot be.
   std::vector<Shape> collision;
