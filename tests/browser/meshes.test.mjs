@@ -44,6 +44,7 @@ function expectedBoxes([q1, q2, q3]) {
     fore_link: [fore, [0, -0.025, -0.02], [0.3, 0.025, 0.02]],                // forearm.stl, mm scaled by 0.001
     hand_link: [mul(mul(hand, T(0.01, 0, 0)), Rx(0.5)), [0, -0.03, -0.01], [0.1, 0.03, 0.01]], // hand.obj
     sensor_link: [mul(hand, T(0.1 + 0.02, 0, 0)), [-0.02, -0.015, -0.01], [0.02, 0.015, 0.01]], // its collision box
+    tag_link: [mul(fore, T(0.15, 0, 0.02)), [-0.03, -0.02, 0], [0.03, 0.02, 0.025]],       // its collision mesh: base.obj / 4
   };
   const boxes = {};
   for (const [link, [m, lo, hi]] of Object.entries(want)) {
@@ -80,7 +81,8 @@ function checkBoxes({ shapes, q }) {
 
 const meshesDone = () => {
   const d = window.rp.view.drawnShapes('arm');
-  return d && d.every((s) => s.state !== 'loading') && window.rp.view.meshes.failed >= 1;
+  return d && d.every((s) => s.state !== 'loading') && window.rp.view.meshes.failed >= 1 &&
+    window.rp.view.meshes.loaded >= 5;
 };
 
 describe('URDF meshes of a UrdfManipulator', () => {
@@ -95,7 +97,7 @@ describe('URDF meshes of a UrdfManipulator', () => {
     const shapes = await sample(page);
     assert.deepEqual(Object.fromEntries(shapes.shapes.map((s) => [s.link, s.state])), {
       base_link: 'mesh', upper_link: 'mesh', cam_link: 'placeholder', fore_link: 'mesh', hand_link: 'mesh',
-      sensor_link: 'fallback',
+      sensor_link: 'fallback', tag_link: 'fallback',
     });
     checkBoxes(shapes);
     // The hand's texture (a 4 x 4 checker board) is on its material; the forearm's missing one is not.
@@ -106,7 +108,7 @@ describe('URDF meshes of a UrdfManipulator', () => {
       let map = null;
       hand.traverse((c) => { if (c.isMesh && c.material.map) map = [c.material.map.image.width, c.material.map.image.height]; });
       return { textures: d.map((s) => s.texture), map };
-    }), { textures: [null, null, null, 'failed', 'drawn', null], map: [4, 4] });
+    }), { textures: [null, null, null, 'failed', 'drawn', null, null], map: [4, 4] });
 
     for (const [joint, value] of [[0, 0.7], [1, -0.5], [2, 0.8]])
       await ctx.page.evaluate(([j, v]) => window.rp.conn.message('jointmove', 'setJoint', JSON.stringify({ joint: j, value: v })), [joint, value]);
@@ -130,13 +132,14 @@ describe('URDF meshes of a UrdfManipulator', () => {
     assert.match(label, /cam_link: package:\/\/rp_mesh_arm\/meshes\/broken\.dae: /);
     assert.match(label, /sensor_link: package:\/\/rp_mesh_arm\/meshes\/missing_sensor\.dae: no such file/);
     assert.match(label, /fore_link: texture package:\/\/rp_mesh_arm\/textures\/missing_paint\.png: no such file/);
-    // The label stands next to the arm, inside the view.
+    // The label stands next to the arm, wholly inside the view.
     const box = await page.evaluate(() => {
       const r = document.querySelector('.mesh-problems[data-object="arm"]').getBoundingClientRect();
       const v = document.getElementById('view').getBoundingClientRect();
-      return { left: r.left - v.left, top: r.top - v.top, width: v.width, height: v.height };
+      return { left: r.left - v.left, top: r.top - v.top, right: r.right - v.left, bottom: r.bottom - v.top,
+        width: v.width, height: v.height };
     });
-    assert.ok(box.left >= 0 && box.left < box.width && box.top >= 0 && box.top < box.height, JSON.stringify(box));
+    assert.ok(box.left >= 0 && box.right <= box.width && box.top >= 0 && box.bottom <= box.height, JSON.stringify(box));
     // Two pages drew the arm (and the Joint Move page): each file is reported once on stderr.
     await waitInPage(page, () => true);
     const out = () => ctx.program.output();
@@ -146,6 +149,25 @@ describe('URDF meshes of a UrdfManipulator', () => {
     assert.match(out(), /missing_sensor\.dae of link 'sensor_link' of 'arm' .*no such file .*drawn with its collision geometry/);
     assert.equal(out().match(/rp: Scene Viewer: texture \S*missing_paint\.png/g)?.length, 1, out());
     await page.close();
+  });
+
+  it('serves only the files the description names that exist', async () => {
+    const token = new URL(ctx.url).searchParams.get('token');
+    const status = await ctx.page.evaluate(async (t) => {
+      const out = [];
+      for (let i = 0; i < 12; ++i) {
+        const r = await fetch(`mesh?object=arm&shape=${i}${t ? `&token=${t}` : ''}`);
+        out.push([r.status, r.headers.get('content-type')]);
+      }
+      return out;
+    }, token);
+    const ok = [200, 'application/octet-stream'];
+    assert.deepEqual(status, [
+      ok, ok, ok, ok, ok,                // base.obj, upper_arm.dae, broken.dae (served; the page cannot parse it), forearm.stl, hand.obj
+      [404, 'text/plain'], [404, 'text/plain'], // missing_sensor.dae, missing_tag.stl: no file
+      [200, 'image/png'], ok,           // the hand's texture, the tag's collision mesh
+      [404, 'text/plain'], [404, 'text/plain'], [404, 'text/plain'], // nothing more
+    ]);
   });
 
   it('frames the arm when the page opens', async () => {

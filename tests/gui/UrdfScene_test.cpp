@@ -131,7 +131,7 @@ TEST(UrdfScene, MeshesThroughThePackagePathAndTheirProblems) {
   }
   std::filesystem::remove_all(dir);
   ASSERT_TRUE(arm.is_object()) << "the arm is not in the scene";
-  ASSERT_EQ(arm["shapes"].size(), 6u) << arm.dump();
+  ASSERT_EQ(arm["shapes"].size(), 7u) << arm.dump();
   const json& upper = arm["shapes"][1];
   EXPECT_EQ(upper.value("link", ""), "upper_link");
   EXPECT_EQ(upper.value("uri", ""), "package://rp_mesh_arm/meshes/upper_arm.dae");
@@ -143,6 +143,9 @@ TEST(UrdfScene, MeshesThroughThePackagePathAndTheirProblems) {
   EXPECT_NE(sensor.value("meshError", "").find("no such file"), std::string::npos) << sensor.dump();
   ASSERT_EQ(sensor["fallback"].size(), 1u);
   EXPECT_EQ(sensor["fallback"][0].value("kind", ""), "box");
+  // The tag's collision mesh and the hand's texture are served after the visuals.
+  EXPECT_EQ(arm["shapes"][4]["texture"].value("meshShape", -1), 7);
+  EXPECT_EQ(arm["shapes"][6]["fallback"][0].value("meshShape", -1), 8);
   // The missing mesh was printed when the arm was described; the page's report once per file.
   EXPECT_EQ(printed, "printed");
   EXPECT_EQ(again, "");

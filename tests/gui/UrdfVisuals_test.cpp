@@ -154,7 +154,7 @@ std::string meshOf(const std::vector<rp::UrdfVisual>& visuals, const std::string
 TEST(UrdfVisuals, PackageMeshesFoundInTheFoldersAboveTheDescription) {
   TempDir temp;
   const auto visuals = rp::readUrdfVisuals(kMeshArm, {"hand_link", {}});
-  ASSERT_EQ(visuals.size(), 6u);
+  ASSERT_EQ(visuals.size(), 7u);
   const auto meshes = std::filesystem::absolute(kPackages + "/rp_mesh_arm/meshes").lexically_normal();
   EXPECT_EQ(meshOf(visuals, "upper_link"), (meshes / "upper_arm.dae").string());
   EXPECT_EQ(meshOf(visuals, "fore_link"), (meshes / "forearm.stl").string());
@@ -170,7 +170,8 @@ TEST(UrdfVisuals, PackageMeshesFoundInTheFoldersAboveTheDescription) {
   EXPECT_EQ(visuals[3].textureFile, "");
   EXPECT_NE(visuals[3].textureError.find("no such file"), std::string::npos) << visuals[3].textureError;
   EXPECT_EQ(visuals[0].textureUri, "");
-  for (const auto& v : visuals) EXPECT_EQ(v.meshError, v.link == "sensor_link" ? v.meshError : "") << v.link;
+  for (const auto& v : visuals)
+    EXPECT_EQ(v.meshError, v.link == "sensor_link" || v.link == "tag_link" ? v.meshError : "") << v.link;
 }
 
 TEST(UrdfVisuals, MovedDescriptionFindsItsPackagesThroughThePackagePath) {
@@ -179,7 +180,7 @@ TEST(UrdfVisuals, MovedDescriptionFindsItsPackagesThroughThePackagePath) {
   std::filesystem::copy_file(kMeshArm, moved);
   // Nothing above the moved file holds the package: not found, and the error says where it looked.
   auto lost = rp::readUrdfVisuals(moved.string(), {"hand_link", {}});
-  ASSERT_EQ(lost.size(), 6u);
+  ASSERT_EQ(lost.size(), 7u);
   EXPECT_EQ(lost[1].shape.meshFile, "");
   EXPECT_NE(lost[1].meshError.find("no such file"), std::string::npos) << lost[1].meshError;
   EXPECT_NE(lost[1].meshError.find((temp.path() / "rp_mesh_arm/meshes/upper_arm.dae").string()), std::string::npos)
@@ -215,6 +216,13 @@ TEST(UrdfVisuals, MeshesThatCannotBeDrawnSayWhyAndBringTheCollisionGeometry) {
   EXPECT_NEAR((sensor.collision[0].pose - rp::Transform(sensor.shape.pose * rp::translation(0.02, 0, 0))).cwiseAbs().maxCoeff(),
               0, 1e-12);
   EXPECT_TRUE(visuals[1].collision.empty());
+  // The tag's collision mesh is found through the package as the visuals are.
+  EXPECT_EQ(visuals[6].link, "tag_link");
+  ASSERT_EQ(visuals[6].collision.size(), 1u);
+  EXPECT_EQ(visuals[6].collision[0].kind, rp::ShapeKind::Mesh);
+  EXPECT_EQ(visuals[6].collision[0].meshFile,
+            std::filesystem::absolute(kPackages + "/rp_mesh_arm/meshes/base.obj").lexically_normal().string());
+  EXPECT_DOUBLE_EQ(visuals[6].collision[0].size(2), 0.25);
   // A format the page does not draw is refused here, naming the formats it draws.
   std::filesystem::copy_file(kMeshArm, temp.path() / "arm.urdf");
   std::ofstream(temp.path() / "part.ply") << "ply\n";

@@ -194,8 +194,11 @@ export class SceneView {
       const w = this.container.clientWidth;
       const h = this.container.clientHeight;
       const inside = v.z < 1 && Math.abs(v.x) <= 1 && Math.abs(v.y) <= 1;
-      o.label.style.left = `${Math.round(((inside ? v.x : 0) + 1) / 2 * w)}px`;
-      o.label.style.top = `${Math.round((1 - (inside ? v.y : 0.9)) / 2 * h)}px`;
+      // Right of the link's frame, centred on it, kept inside the view.
+      const x = ((inside ? v.x : 0) + 1) / 2 * w + 12;
+      const y = (1 - (inside ? v.y : 0.9)) / 2 * h - o.label.offsetHeight / 2;
+      o.label.style.left = `${Math.round(Math.max(0, Math.min(x, w - o.label.offsetWidth)))}px`;
+      o.label.style.top = `${Math.round(Math.max(0, Math.min(y, h - o.label.offsetHeight)))}px`;
       o.label.hidden = !o.root.visible;
     }
   }
