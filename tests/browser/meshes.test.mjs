@@ -100,6 +100,15 @@ describe('URDF meshes of a UrdfManipulator', () => {
       sensor_link: 'fallback', tag_link: 'fallback',
     });
     checkBoxes(shapes);
+    // Every mesh is lit: the DAE (no normals) and the STL (zero facet normals) get their faces' normals.
+    assert.deepEqual(await page.evaluate(() => {
+      const unlit = [];
+      window.rp.view.objects.get('arm').root.traverse((c) => {
+        const n = c.isMesh && c.geometry.getAttribute('normal');
+        if (c.isMesh && (!n || n.array.every((x) => x === 0))) unlit.push(c.name || c.geometry.type);
+      });
+      return unlit;
+    }), []);
     // The hand's texture (a 4 x 4 checker board) is on its material; the forearm's missing one is not.
     await waitInPage(page, () => window.rp.view.drawnShapes('arm').every((s) => s.texture !== 'loading'));
     assert.deepEqual(await page.evaluate(() => {

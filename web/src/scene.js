@@ -39,6 +39,10 @@ function loadMesh(holder, url, file, material, materials, onDone) {
     holder.add(object);
     object.traverse((c) => {
       c.userData.object = holder.userData.object;
+      // Files without normals (or with zero ones, as many STL exporters write) would be drawn
+      // black: their faces' normals are computed, as RViz does.
+      const normal = c.isMesh && c.geometry && c.geometry.getAttribute('normal');
+      if (c.isMesh && c.geometry && (!normal || normal.array.every((x) => x === 0))) c.geometry.computeVertexNormals();
       if (c.material) for (const m of [].concat(c.material)) if (m !== material && !materials.includes(m)) materials.push(m);
     });
     onDone(null);
@@ -186,17 +190,22 @@ export class SceneView {
         o.label.dataset.object = o.desc.name;
         this.container.appendChild(o.label);
       }
-      const text = `${o.desc.name}: drawn without\n${o.problems.map((p) => p.text).join('\n')}`;
-      if (o.label.textContent !== text) o.label.textContent = text;
-      const frame = o.frames.find((f) => f.name === o.problems[0].frame) || o.frames[0];
+      // The places looked at are on the program's stderr (and in the tooltip), not in the note.
+      const full = `${o.desc.name}: drawn without\n${o.problems.map((p) => p.text).join('\n')}`;
+      const text = full.replace(/ \(looked in [^)]*\)/g, '');
+      if (o.label.textContent !== text) {
+        o.label.textContent = text;
+        o.label.title = full;
+      }
+      const frame = o.frames[0]; // the object's base: the note stays clear of a moving arm
       frame.updateWorldMatrix(true, false);
       v.setFromMatrixPosition(frame.matrixWorld).project(this.camera);
       const w = this.container.clientWidth;
       const h = this.container.clientHeight;
       const inside = v.z < 1 && Math.abs(v.x) <= 1 && Math.abs(v.y) <= 1;
-      // Right of the link's frame, centred on it, kept inside the view.
+      // Below and right of the object's base, kept inside the view.
       const x = ((inside ? v.x : 0) + 1) / 2 * w + 12;
-      const y = (1 - (inside ? v.y : 0.9)) / 2 * h - o.label.offsetHeight / 2;
+      const y = (1 - (inside ? v.y : 0.9)) / 2 * h + 12;
       o.label.style.left = `${Math.round(Math.max(0, Math.min(x, w - o.label.offsetWidth)))}px`;
       o.label.style.top = `${Math.round(Math.max(0, Math.min(y, h - o.label.offsetHeight)))}px`;
       o.label.hidden = !o.root.visible;
