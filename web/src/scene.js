@@ -216,7 +216,8 @@ export class SceneView {
   fitView() {
     const box = new THREE.Box3();
     this.scene.updateMatrixWorld(true);
-    for (const o of this.objects.values()) if (o.root.visible) box.expandByObject(o.root, true);
+    // Each geometry's own bounding box, transformed (cheap; a little larger than the exact box).
+    for (const o of this.objects.values()) if (o.root.visible) box.expandByObject(o.root);
     if (box.isEmpty()) return false;
     const sphere = box.getBoundingSphere(new THREE.Sphere());
     const radius = Math.max(sphere.radius, 0.05);
