@@ -1,8 +1,11 @@
 // Scene description and binary state frames for the Scene Viewer (see SceneState.hpp).
 #include "SceneState.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <iostream>
 #include <set>
 
 #include "rp/core/ObjectManager.hpp"
@@ -87,16 +90,49 @@ void putTransform(std::string& out, const Transform& t) {
 }  // namespace
 
 // The <visual> elements of a UrdfManipulator's URDF file (made in code or from rp.cfg), read
-// once per object.
+// once per object; a mesh that cannot be drawn is reported on stderr (once per file).
 void SceneState::loadVisuals(Entry& e) {
   e.urdfLoaded = true;
   const auto* arm = dynamic_cast<const UrdfManipulator*>(e.object);
   if (arm == nullptr || arm->getUrdfFile().empty()) return;
   try {
-    e.urdfShapes = loadUrdfVisuals(arm->getUrdfFile(), arm->getTip());
+    UrdfVisualOptions options;
+    options.tip = arm->getTip();
+    options.packagePath = arm->getPackagePath();
+    e.urdfVisuals = readUrdfVisuals(arm->getUrdfFile(), options);
   } catch (const std::exception& ex) {
     e.urdfError = ex.what();
+    reportOnce(arm->getUrdfFile(), "rp: Scene Viewer: '" + e.name + "' is drawn without its URDF visuals: " + ex.what());
+    return;
   }
+  for (const UrdfVisual& v : e.urdfVisuals) {
+    if (!v.textureError.empty())
+      reportOnce(v.textureUri, "rp: Scene Viewer: texture " + v.textureUri + " of link '" + v.link + "' of '" + e.name +
+                                   "' (" + arm->getUrdfFile() + "): " + v.textureError + "; drawn in its colour");
+    if (!v.meshError.empty())
+      reportOnce(v.meshUri, "rp: Scene Viewer: mesh " + v.meshUri + " of link '" + v.link + "' of '" + e.name +
+                                "' (" + arm->getUrdfFile() + "): " + v.meshError + "; drawn " +
+                                (v.collision.empty() ? "as a placeholder" : "with its collision geometry"));
+  }
+}
+
+bool SceneState::reportOnce(const std::string& file, const std::string& what) {
+  if (!reportedMeshes_.insert(file).second) return false;
+  std::cerr << what << std::endl;
+  return true;
+}
+
+bool SceneState::reportMeshFailure(const std::string& name, std::size_t shape, const std::string& why) {
+  const std::string file = meshFile(name, shape);
+  if (file.empty()) return false;
+  std::string text;  // the page's words, without control characters
+  for (char c : why.substr(0, 200)) text += std::iscntrl(static_cast<unsigned char>(c)) ? ' ' : c;
+  std::string ext = std::filesystem::path(file).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool image = ext == ".png" || ext == ".jpg" || ext == ".jpeg";  // a URDF texture
+  return reportOnce(file, std::string("rp: Scene Viewer: ") + (image ? "texture " : "mesh ") + file + " of '" + name +
+                              "' cannot be drawn: " + text +
+                              (image ? "; drawn in its colour" : "; drawn with its collision geometry or a placeholder"));
 }
 
 SceneState::SceneState() = default;
@@ -152,25 +188,64 @@ json SceneState::describe(Entry& e) {
   e.frames.clear();
   if (e.physical) {
     Model3D m = e.physical->get3DModel();
-    if (e.manipulator) {  // a UrdfManipulator (loadVisuals() checks) is drawn with its URDF visuals
-      if (!e.urdfLoaded) loadVisuals(e);
-      if (!e.urdfShapes.empty()) {
-        m.shapes = e.urdfShapes;  // the URDF's own look instead of the generic links
-        j["urdfVisuals"] = true;
-      }
-      if (!e.urdfError.empty()) j["urdfError"] = e.urdfError;
+    // A UrdfManipulator (loadVisuals() checks) is drawn with its URDF visuals.
+    if (e.manipulator && !e.urdfLoaded) loadVisuals(e);
+    const bool urdf = e.manipulator && !e.urdfVisuals.empty();
+    if (urdf) {
+      m.shapes.clear();  // the URDF's own look instead of the generic links
+      for (const UrdfVisual& v : e.urdfVisuals) m.shapes.push_back(v.shape);
+      j["urdfVisuals"] = true;
     }
+    if (!e.urdfError.empty()) j["urdfError"] = e.urdfError;
     e.frames = m.frames;
     json shapes = json::array();
     e.meshes.clear();
+    auto shapeJson = [](const Shape& s) {
+      return json{{"kind", shapeKindName(s.kind)},
+                  {"frame", s.frame},
+                  {"pose", transformJson(s.pose)},
+                  {"size", {s.size(0), s.size(1), s.size(2)}},
+                  {"mesh", s.meshFile},
+                  {"color", {s.color.r, s.color.g, s.color.b, s.color.a}}};
+    };
     for (const Shape& s : m.shapes) {
       e.meshes.push_back(s.kind == ShapeKind::Mesh ? s.meshFile : std::string());
-      shapes.push_back({{"kind", shapeKindName(s.kind)},
-                        {"frame", s.frame},
-                        {"pose", transformJson(s.pose)},
-                        {"size", {s.size(0), s.size(1), s.size(2)}},
-                        {"mesh", s.meshFile},
-                        {"color", {s.color.r, s.color.g, s.color.b, s.color.a}}});
+      shapes.push_back(shapeJson(s));
+    }
+    if (urdf) {
+      // Each visual's link, its mesh as the URDF names it, why it cannot be drawn, and the link's
+      // collision shapes to draw instead (their meshes served as shapes after the visuals).
+      for (std::size_t i = 0; i < e.urdfVisuals.size(); ++i) {
+        const UrdfVisual& v = e.urdfVisuals[i];
+        json& js = shapes[i];
+        js["link"] = v.link;
+        if (v.shape.kind == ShapeKind::Mesh) {
+          js["mesh"] = v.shape.meshFile.empty() ? v.meshUri : v.shape.meshFile;
+          js["uri"] = v.meshUri;
+          if (!v.meshError.empty()) js["meshError"] = v.meshError;
+        }
+        if (!v.textureUri.empty()) {
+          json texture = {{"uri", v.textureUri}};
+          if (!v.textureError.empty()) {
+            texture["error"] = v.textureError;
+          } else {
+            texture["meshShape"] = e.meshes.size();  // served as the meshes are
+            e.meshes.push_back(v.textureFile);
+          }
+          js["texture"] = std::move(texture);
+        }
+        json fallback = json::array();
+        for (const Shape& c : v.collision) {
+          json jc = shapeJson(c);
+          jc["color"] = js["color"];
+          if (c.kind == ShapeKind::Mesh) {
+            jc["meshShape"] = e.meshes.size();
+            e.meshes.push_back(c.meshFile);
+          }
+          fallback.push_back(std::move(jc));
+        }
+        js["fallback"] = std::move(fallback);
+      }
     }
     j["frames"] = m.frames;
     j["shapes"] = shapes;

@@ -7,11 +7,13 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "rp/core/PhysicalObject.hpp"
 #include "rp/core/RoboticObject.hpp"
+#include "rp/gui/UrdfVisuals.hpp"
 
 namespace rp {
 class ControlProgram;
@@ -43,8 +45,14 @@ class SceneState {
   // Builds one binary state frame of every described object that still exists.
   std::string buildFrame();
 
-  // The mesh file of shape `shape` of the described object `name` (empty if there is none).
+  // The mesh file of shape `shape` of the described object `name` (empty if there is none). A
+  // URDF arm's collision meshes (drawn instead of visuals that cannot be) follow its shapes: the
+  // shape's `fallback` entries in the scene give their numbers.
   std::string meshFile(const std::string& name, std::size_t shape) const;
+
+  // A page could not draw mesh `shape` of object `name` (`why`, from the page): prints it on
+  // stderr once per file (returns true then). Only files the scene names are reported.
+  bool reportMeshFailure(const std::string& name, std::size_t shape, const std::string& why);
 
  private:
   struct Entry {
@@ -60,16 +68,19 @@ class SceneState {
     nlohmann::json description;  // the last description
     std::vector<std::string> meshes;  // mesh file of each shape (empty for other shapes)
     bool urdfLoaded = false;          // a UrdfManipulator's visuals were looked for
-    std::vector<Shape> urdfShapes;    // its URDF <visual> elements (empty: none)
+    std::vector<UrdfVisual> urdfVisuals;  // its URDF <visual> elements (empty: none)
     std::string urdfError;            // why they could not be read
   };
   nlohmann::json describe(Entry& e);
-  static void loadVisuals(Entry& e);
+  void loadVisuals(Entry& e);
+  // Prints `what` about mesh `file` on stderr unless it was printed for that file already.
+  bool reportOnce(const std::string& file, const std::string& what);
 
   std::map<RoboticObject*, Entry> entries_;
   std::string sceneMessage_;
   std::string lastObjects_;
   std::uint32_t version_ = 0;
+  std::set<std::string> reportedMeshes_;  // mesh files whose problem was printed on stderr
 };
 
 }  // namespace rp::internal

@@ -526,7 +526,11 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
     if (file.empty() || !std::filesystem::is_regular_file(file, ec) ||
         std::filesystem::file_size(file, ec) > kMaxMeshFileBytes || ec || !readFileCapped(file, kMaxMeshFileBytes, body))
       return respond(http::status::not_found, "text/plain", "no mesh file for that shape\n", req);
-    respond(http::status::ok, "application/octet-stream", std::move(body), req);
+    // A URDF texture is an image (the page loads it as one); meshes are bytes.
+    std::string ext = std::filesystem::path(file).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const char* type = ext == ".png" ? "image/png" : ext == ".jpg" || ext == ".jpeg" ? "image/jpeg" : "application/octet-stream";
+    respond(http::status::ok, type, std::move(body), req);
   }
 
   void respond(http::status status, const std::string& type, std::string body,
@@ -777,6 +781,17 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
 
   std::string object;
   if (!str("object", object)) return;
+  if (type == "meshFailed") {
+    // A page could not draw a mesh the scene names: printed on stderr once per file.
+    auto shape = msg.find("shape");
+    if (shape == msg.end() || !shape->is_number_integer() || shape->get<long long>() < 0 ||
+        shape->get<long long>() > 1000000)
+      return refuse("'shape' must be a non-negative integer");
+    std::string why;
+    if (!str("message", why)) return;
+    const bool printed = scene.reportMeshFailure(object, static_cast<std::size_t>(shape->get<long long>()), why);
+    return session->sendText(json{{"type", "result"}, {"id", id}, {"ok", true}, {"reply", printed ? "printed" : ""}}.dump());
+  }
   std::function<std::string()> action;  // runs in the worker; returns the reply text; throws on failure
   if (type == "command") {
     std::string command;
@@ -847,8 +862,8 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     };
   } else {
     return refuse("unknown message type '" + type +
-                  "' (known: hello, ping, scene, command, display, setParameter, message, emergencyStop, logInfo, logging, "
-                  "logSubscribe)");
+                  "' (known: hello, ping, scene, command, display, setParameter, message, meshFailed, emergencyStop, logInfo, "
+                  "logging, logSubscribe)");
   }
 
   std::weak_ptr<WsSession> weak = session;

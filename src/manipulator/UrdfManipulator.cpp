@@ -9,6 +9,7 @@
 
 #include "rp/core/RoboticPlatform.hpp"
 #include "rp/core/TypeDatabase.hpp"
+#include "rp/gui/UrdfVisuals.hpp"
 
 namespace rp {
 
@@ -53,12 +54,22 @@ UrdfManipulator::UrdfManipulator(const std::string& name, const std::string& urd
 
 UrdfManipulator::~UrdfManipulator() { stopControlLoop(); }
 
+std::vector<std::string> UrdfManipulator::getPackagePath() const {
+  if (const ConfigSection* section = RoboticPlatform::getConfiguration().findSection(getName()))
+    if (section->has("packagePath"))
+      return splitPackagePath(section->getWord("packagePath"),
+                              std::filesystem::path(section->fileName()).parent_path().string());
+  return {};
+}
+
 void UrdfManipulator::declareSettings(SettingSchema& schema) {
   DefaultManipulator::declareSettings(schema);
   schema.addWord("urdf", "URDF file of the arm");
   schema.addWord("tip", "last link of the chain");
+  schema.addWord("packagePath", "folders holding the packages of package:// mesh files, separated by ':'");
   schema.setDefault("urdf", "the constructor's argument");
   schema.setDefault("tip", "the constructor's argument");
+  schema.setDefault("packagePath", "(none: ROS_PACKAGE_PATH, then the folders above the URDF file)");
 }
 
 }  // namespace rp

@@ -7,10 +7,12 @@
 
 #include <Eigen/Geometry>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
+#include <unistd.h>
 
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/ManipulatorData.hpp"
@@ -135,6 +137,135 @@ TEST(UrdfVisuals, FollowTheDefaultTipOfTheModel) {
   ASSERT_EQ(shapes.size(), 2u);
   for (const auto& s : shapes) EXPECT_EQ(s.frame, "link1");
   std::filesystem::remove(file);
+}
+
+// The mesh arm of the browser test, in its package folder rp_mesh_arm (package:// URIs).
+const std::string kPackages = std::string(RP_TEST_DATA_DIR) + "/packages";
+const std::string kMeshArm = kPackages + "/rp_mesh_arm/urdf/mesh_arm.urdf";
+
+// A temporary folder removed at the end of the test; ROS_PACKAGE_PATH unset meanwhile.
+class TempDir {
+ public:
+  TempDir() {
+    path_ = std::filesystem::temp_directory_path() / ("rp-urdf-visuals-" + std::to_string(::getpid()) + "-" +
+                                                      std::to_string(counter_++));
+    std::filesystem::create_directories(path_);
+    if (const char* env = std::getenv("ROS_PACKAGE_PATH")) saved_ = env, hadEnv_ = true;
+    ::unsetenv("ROS_PACKAGE_PATH");
+  }
+  ~TempDir() {
+    std::filesystem::remove_all(path_);
+    if (hadEnv_) ::setenv("ROS_PACKAGE_PATH", saved_.c_str(), 1);
+    else ::unsetenv("ROS_PACKAGE_PATH");
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  static inline int counter_ = 0;
+  std::filesystem::path path_;
+  std::string saved_;
+  bool hadEnv_ = false;
+};
+
+std::string meshOf(const std::vector<rp::UrdfVisual>& visuals, const std::string& link) {
+  for (const auto& v : visuals)
+    if (v.link == link) return v.shape.meshFile;
+  return "<no visual of " + link + ">";
+}
+
+TEST(UrdfVisuals, PackageMeshesFoundInTheFoldersAboveTheDescription) {
+  TempDir temp;
+  const auto visuals = rp::readUrdfVisuals(kMeshArm, {"hand_link", {}});
+  ASSERT_EQ(visuals.size(), 7u);
+  const auto meshes = std::filesystem::absolute(kPackages + "/rp_mesh_arm/meshes").lexically_normal();
+  EXPECT_EQ(meshOf(visuals, "upper_link"), (meshes / "upper_arm.dae").string());
+  EXPECT_EQ(meshOf(visuals, "fore_link"), (meshes / "forearm.stl").string());
+  EXPECT_EQ(meshOf(visuals, "hand_link"), (meshes / "hand.obj").string());
+  EXPECT_EQ(visuals[0].link, "base_link");
+  EXPECT_EQ(visuals[0].meshUri, "package://rp_mesh_arm/meshes/base.obj");
+  EXPECT_NEAR(visuals[0].shape.color.b, 0.45, 1e-6);  // the robot's material "slate"
+  EXPECT_DOUBLE_EQ(visuals[3].shape.size(0), 0.001);  // the STL's scale
+  // The hand's texture is found as the meshes are; the forearm's does not exist.
+  EXPECT_EQ(visuals[4].textureUri, "package://rp_mesh_arm/textures/checker.png");
+  EXPECT_EQ(visuals[4].textureFile, (meshes.parent_path() / "textures/checker.png").string());
+  EXPECT_EQ(visuals[4].textureError, "");
+  EXPECT_EQ(visuals[3].textureFile, "");
+  EXPECT_NE(visuals[3].textureError.find("no such file"), std::string::npos) << visuals[3].textureError;
+  EXPECT_EQ(visuals[0].textureUri, "");
+  for (const auto& v : visuals)
+    EXPECT_EQ(v.meshError, v.link == "sensor_link" || v.link == "tag_link" ? v.meshError : "") << v.link;
+}
+
+TEST(UrdfVisuals, MovedDescriptionFindsItsPackagesThroughThePackagePath) {
+  TempDir temp;
+  const auto moved = temp.path() / "mesh_arm.urdf";
+  std::filesystem::copy_file(kMeshArm, moved);
+  // Nothing above the moved file holds the package: not found, and the error says where it looked.
+  auto lost = rp::readUrdfVisuals(moved.string(), {"hand_link", {}});
+  ASSERT_EQ(lost.size(), 7u);
+  EXPECT_EQ(lost[1].shape.meshFile, "");
+  EXPECT_NE(lost[1].meshError.find("no such file"), std::string::npos) << lost[1].meshError;
+  EXPECT_NE(lost[1].meshError.find((temp.path() / "rp_mesh_arm/meshes/upper_arm.dae").string()), std::string::npos)
+      << lost[1].meshError;
+  // The package path (as rp.cfg's packagePath gives it) finds them; a folder without the package is passed over.
+  const auto found = rp::readUrdfVisuals(moved.string(), {"hand_link", {"/nonexistent", kPackages}});
+  EXPECT_EQ(found[1].meshError, "");
+  EXPECT_EQ(found[1].shape.meshFile,
+            std::filesystem::absolute(kPackages + "/rp_mesh_arm/meshes/upper_arm.dae").lexically_normal().string());
+  // So does ROS_PACKAGE_PATH.
+  ::setenv("ROS_PACKAGE_PATH", ("/nonexistent:" + kPackages).c_str(), 1);
+  EXPECT_EQ(rp::readUrdfVisuals(moved.string(), {"hand_link", {}})[1].shape.meshFile, found[1].shape.meshFile);
+  // The package path comes before ROS_PACKAGE_PATH, each in its order: a second copy of the
+  // package's base.obj in the temporary folder wins when it is listed first.
+  std::filesystem::create_directories(temp.path() / "pkgs/rp_mesh_arm/meshes");
+  std::ofstream(temp.path() / "pkgs/rp_mesh_arm/meshes/base.obj") << "v 0 0 0\n";
+  const auto mine = rp::readUrdfVisuals(moved.string(), {"hand_link", {(temp.path() / "pkgs").string()}});
+  EXPECT_EQ(mine[0].shape.meshFile, (temp.path() / "pkgs/rp_mesh_arm/meshes/base.obj").string());
+  EXPECT_EQ(mine[1].shape.meshFile, found[1].shape.meshFile);  // not in pkgs: from ROS_PACKAGE_PATH
+}
+
+TEST(UrdfVisuals, MeshesThatCannotBeDrawnSayWhyAndBringTheCollisionGeometry) {
+  TempDir temp;
+  const auto visuals = rp::readUrdfVisuals(kMeshArm, {"hand_link", {}});
+  const rp::UrdfVisual& sensor = visuals[5];
+  EXPECT_EQ(sensor.link, "sensor_link");
+  EXPECT_EQ(sensor.shape.meshFile, "");
+  EXPECT_NE(sensor.meshError.find("no such file"), std::string::npos) << sensor.meshError;
+  ASSERT_EQ(sensor.collision.size(), 1u);  // its collision box, in the same frame as the visual
+  EXPECT_EQ(sensor.collision[0].kind, rp::ShapeKind::Box);
+  EXPECT_EQ(sensor.collision[0].frame, sensor.shape.frame);
+  EXPECT_DOUBLE_EQ(sensor.collision[0].size(1), 0.03);
+  EXPECT_NEAR((sensor.collision[0].pose - rp::Transform(sensor.shape.pose * rp::translation(0.02, 0, 0))).cwiseAbs().maxCoeff(),
+              0, 1e-12);
+  EXPECT_TRUE(visuals[1].collision.empty());
+  // The tag's collision mesh is found through the package as the visuals are.
+  EXPECT_EQ(visuals[6].link, "tag_link");
+  ASSERT_EQ(visuals[6].collision.size(), 1u);
+  EXPECT_EQ(visuals[6].collision[0].kind, rp::ShapeKind::Mesh);
+  EXPECT_EQ(visuals[6].collision[0].meshFile,
+            std::filesystem::absolute(kPackages + "/rp_mesh_arm/meshes/base.obj").lexically_normal().string());
+  EXPECT_DOUBLE_EQ(visuals[6].collision[0].size(2), 0.25);
+  // A format the page does not draw is refused here, naming the formats it draws.
+  std::filesystem::copy_file(kMeshArm, temp.path() / "arm.urdf");
+  std::ofstream(temp.path() / "part.ply") << "ply\n";
+  std::ifstream in(kMeshArm);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string base = "package://rp_mesh_arm/meshes/base.obj";
+  text.replace(text.find(base), base.size(), "part.ply");
+  std::ofstream(temp.path() / "arm.urdf", std::ios::trunc) << text;
+  const auto ply = rp::readUrdfVisuals((temp.path() / "arm.urdf").string(), {"hand_link", {kPackages}});
+  EXPECT_EQ(ply[0].shape.meshFile, "");
+  EXPECT_NE(ply[0].meshError.find("format not drawn"), std::string::npos) << ply[0].meshError;
+}
+
+TEST(UrdfVisuals, PackagePathLists) {
+  EXPECT_EQ(rp::splitPackagePath("/a::/b/../c:", "/base"), (std::vector<std::string>{"/a", "/c"}));
+  EXPECT_EQ(rp::splitPackagePath("rel:/abs", "/base"), (std::vector<std::string>{"/base/rel", "/abs"}));
+  EXPECT_TRUE(rp::splitPackagePath("").empty());
+  // Not a package URI that names a file: nothing is found.
+  EXPECT_EQ(rp::resolveMeshUri("package://rp_mesh_arm", kMeshArm, {kPackages}), "");
+  EXPECT_EQ(rp::resolveMeshUri("package://../rp_mesh_arm/meshes/base.obj", kMeshArm, {kPackages}), "");
+  EXPECT_EQ(rp::resolveMeshUri("https://example.org/m.dae", kMeshArm, {}), "https://example.org/m.dae");
 }
 
 }  // namespace

@@ -143,4 +143,8 @@ export class Connection {
   message(object, messageType, payload) {
     return this.request({ type: 'message', object, messageType, payload });
   }
+  // Tells the server that mesh `shape` of `object` cannot be drawn (it reports it on stderr).
+  meshFailed(object, shape, message) {
+    return this.request({ type: 'meshFailed', object, shape, message: message || 'cannot be drawn' });
+  }
 }

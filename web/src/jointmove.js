@@ -81,6 +81,7 @@ const conn = new Connection({
   },
   onError: notify,
 });
+view.onMeshFailed = (object, shape, message) => conn.meshFailed(object, shape, message).catch(() => {});
 
 window.rp = {
   conn,

@@ -40,6 +40,7 @@ const conn = new Connection({
   },
   onError: notify,
 });
+view.onMeshFailed = (object, shape, message) => conn.meshFailed(object, shape, message).catch(() => {});
 const menu = new PopupMenu(conn, openPanel, notify);
 const showMenu = (name, x, y) => {
   const desc = scene && scene.objects.find((o) => o.name === name);

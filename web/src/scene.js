@@ -7,6 +7,7 @@ import { STLLoader } from 'three/examples/jsm/loaders/STLLoader.js';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { ColladaLoader } from 'three/examples/jsm/loaders/ColladaLoader.js';
 import { VRMLLoader } from 'three/examples/jsm/loaders/VRMLLoader.js';
+import { OBJLoader } from 'three/examples/jsm/loaders/OBJLoader.js';
 
 const unitCylinder = new THREE.CylinderGeometry(1, 1, 1, 20); // along y, height 1
 const unitBox = new THREE.BoxGeometry(1, 1, 1);
@@ -24,21 +25,78 @@ function meshUrl(name, index, file) {
   return `mesh?object=${encodeURIComponent(name)}&shape=${index}${token ? `&token=${encodeURIComponent(token)}` : ''}`;
 }
 
-// Loads a mesh file (STL, glTF/GLB, Collada, VRML, by the file's extension) into `holder`.
-function loadMesh(holder, url, file, material, onDone) {
+// Loads a mesh file (STL, Collada, Wavefront OBJ, glTF/GLB, VRML, by the file's extension) into
+// `holder`; `onDone(null)` when it is drawn, `onDone(message)` when it cannot be. STL and OBJ files
+// (no colours of their own) are drawn with `material` (the URDF's colour); the materials a file
+// brings are added to `materials` (for the display mode).
+function loadMesh(holder, url, file, material, materials, onDone) {
   const ext = file.toLowerCase().split('.').pop();
   const done = (object) => {
+    if (!object || !object.isObject3D) {
+      onDone('the file holds no drawable scene');
+      return;
+    }
     holder.add(object);
-    object.traverse((c) => (c.userData.object = holder.userData.object));
-    onDone(true);
+    object.traverse((c) => {
+      c.userData.object = holder.userData.object;
+      // Files without normals (or with zero ones, as many STL exporters write) would be drawn
+      // black: their faces' normals are computed, as RViz does.
+      const normal = c.isMesh && c.geometry && c.geometry.getAttribute('normal');
+      if (c.isMesh && c.geometry && (!normal || normal.array.every((x) => x === 0))) c.geometry.computeVertexNormals();
+      if (c.material) for (const m of [].concat(c.material)) if (m !== material && !materials.includes(m)) materials.push(m);
+    });
+    onDone(null);
   };
-  const fail = () => onDone(false);
-  if (ext === 'stl') new STLLoader().load(url, (g) => done(new THREE.Mesh(g, material)), undefined, fail);
-  else if (ext === 'glb' || ext === 'gltf') new GLTFLoader().load(url, (g) => done(g.scene), undefined, fail);
-  else if (ext === 'dae') new ColladaLoader().load(url, (c) => done(c.scene), undefined, fail);
-  else if (ext === 'wrl') new VRMLLoader().load(url, (v) => done(v), undefined, fail);
-  else fail();
+  const fail = (e) => onDone(String((e && e.message) || e || 'cannot be loaded').slice(0, 200));
+  // A loader whose callback throws (a file it cannot parse) reports it through fail().
+  const guard = (f) => (x) => {
+    try {
+      f(x);
+    } catch (e) {
+      fail(e);
+    }
+  };
+  if (ext === 'stl') new STLLoader().load(url, guard((g) => done(new THREE.Mesh(g, material))), undefined, fail);
+  else if (ext === 'obj') {
+    new OBJLoader().load(url, guard((o) => {
+      o.traverse((c) => {
+        if (c.isMesh) c.material = material;
+      });
+      done(o);
+    }), undefined, fail);
+  } else if (ext === 'glb' || ext === 'gltf') new GLTFLoader().load(url, guard((g) => done(g.scene)), undefined, fail);
+  else if (ext === 'dae') {
+    new ColladaLoader().load(url, guard((c) => {
+      if (!c || !c.scene) throw new Error('not a Collada file');
+      // A URDF mesh's vertices are in its link's frame whatever the file's up axis says: undo the
+      // loader's turn of Z_UP files to three.js' Y up (its unit scale, <unit meter>, is kept).
+      c.scene.rotation.set(0, 0, 0);
+      done(c.scene);
+    }), undefined, fail);
+  } else if (ext === 'wrl') new VRMLLoader().load(url, guard((v) => done(v)), undefined, fail);
+  else fail(`the format .${ext} is not drawn`);
 }
+
+// A primitive shape of the scene (box, cylinder along z, sphere) as a three.js mesh.
+function primitive(s, material) {
+  let mesh;
+  if (s.kind === 'cylinder') {
+    mesh = new THREE.Mesh(unitCylinder, material);
+    mesh.scale.set(s.size[0], s.size[1], s.size[0]);
+    mesh.rotation.x = Math.PI / 2; // the model's cylinders run along z
+  } else if (s.kind === 'sphere') {
+    mesh = new THREE.Mesh(unitSphere, material);
+    mesh.scale.setScalar(s.size[0]);
+  } else {
+    mesh = new THREE.Mesh(unitBox, material);
+    mesh.scale.set(s.size[0], s.size[1], s.size[2]);
+  }
+  return mesh;
+}
+
+// The side of the cube drawn in place of a mesh that cannot be drawn and has no collision geometry [m].
+const PLACEHOLDER_SIZE = 0.04;
+const PLACEHOLDER_COLOR = [0.9, 0.1, 0.7, 1];
 
 export class SceneView {
   constructor(container) {
@@ -64,12 +122,21 @@ export class SceneView {
     this.scene.add(new THREE.AxesHelper(0.3));
     this.objects = new Map(); // name -> { root, frames, bones, fingers, desc, materials }
     this.meshes = { loaded: 0, failed: 0 };
+    // Called with (object, shape, message) when a mesh file the server named cannot be drawn
+    // (the page tells the server, which reports it on stderr).
+    this.onMeshFailed = null;
+    // The view frames the scene when the page opens and as meshes arrive, until the user moves it.
+    this.refit = true;
+    this.userMoved = false;
+    this.fits = 0;
+    this.controls.addEventListener('start', () => (this.userMoved = true));
     this.raycaster = new THREE.Raycaster();
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
     const loop = () => {
       requestAnimationFrame(loop);
       this.controls.update();
+      this.placeLabels();
       this.renderer.render(this.scene, this.camera);
     };
     loop();
@@ -96,14 +163,94 @@ export class SceneView {
         this.applyDisplay(old);
         continue;
       }
-      if (old) this.scene.remove(old.root);
+      if (old) this.remove(old);
       this.objects.set(desc.name, this.build(desc, key));
+      this.refit = true;
     }
     for (const [name, o] of this.objects)
       if (!seen.has(name)) {
-        this.scene.remove(o.root);
+        this.remove(o);
         this.objects.delete(name);
       }
+  }
+
+  remove(o) {
+    this.scene.remove(o.root);
+    if (o.label) o.label.remove();
+  }
+
+  // Shows each object's drawing problems (meshes not drawn, URDF visuals not read) next to it.
+  placeLabels() {
+    const v = new THREE.Vector3();
+    for (const o of this.objects.values()) {
+      if (!o.problems.length) continue;
+      if (!o.label) {
+        o.label = document.createElement('div');
+        o.label.className = 'mesh-problems';
+        o.label.dataset.object = o.desc.name;
+        this.container.appendChild(o.label);
+      }
+      // The places looked at are on the program's stderr (and in the tooltip), not in the note.
+      const full = `${o.desc.name}: drawn without\n${o.problems.map((p) => p.text).join('\n')}`;
+      const text = full.replace(/ \(looked in [^)]*\)/g, '');
+      if (o.label.textContent !== text) {
+        o.label.textContent = text;
+        o.label.title = full;
+      }
+      const frame = o.frames[0]; // the object's base: the note stays clear of a moving arm
+      frame.updateWorldMatrix(true, false);
+      v.setFromMatrixPosition(frame.matrixWorld).project(this.camera);
+      const w = this.container.clientWidth;
+      const h = this.container.clientHeight;
+      const inside = v.z < 1 && Math.abs(v.x) <= 1 && Math.abs(v.y) <= 1;
+      // Below and right of the object's base, kept inside the view.
+      const x = ((inside ? v.x : 0) + 1) / 2 * w + 12;
+      const y = (1 - (inside ? v.y : 0.9)) / 2 * h + 12;
+      o.label.style.left = `${Math.round(Math.max(0, Math.min(x, w - o.label.offsetWidth)))}px`;
+      o.label.style.top = `${Math.round(Math.max(0, Math.min(y, h - o.label.offsetHeight)))}px`;
+      o.label.hidden = !o.root.visible;
+    }
+  }
+
+  // Points the camera at the bounding box of every object drawn, from the current direction.
+  fitView() {
+    const box = new THREE.Box3();
+    this.scene.updateMatrixWorld(true);
+    // Each geometry's own bounding box, transformed (cheap; a little larger than the exact box).
+    for (const o of this.objects.values()) if (o.root.visible) box.expandByObject(o.root);
+    if (box.isEmpty()) return false;
+    const sphere = box.getBoundingSphere(new THREE.Sphere());
+    const radius = Math.max(sphere.radius, 0.05);
+    const fov = THREE.MathUtils.degToRad(this.camera.fov);
+    const fit = Math.min(fov, 2 * Math.atan(Math.tan(fov / 2) * this.camera.aspect)) / 2;
+    const distance = (1.15 * radius) / Math.sin(fit);
+    const direction = this.camera.position.clone().sub(this.controls.target).normalize();
+    this.controls.target.copy(sphere.center);
+    this.camera.position.copy(sphere.center).addScaledVector(direction, distance);
+    this.camera.near = Math.max(distance / 1000, 0.001);
+    this.camera.far = Math.max(100, distance * 10);
+    this.camera.updateProjectionMatrix();
+    this.controls.update();
+    this.fits++;
+    return true;
+  }
+
+  // For tests and the console (read only): what is drawn for each shape of object `name`: kind,
+  // URDF link, frame, state ('primitive', 'loading', 'mesh', 'fallback', 'placeholder'), error,
+  // texture (null: none; 'loading', 'drawn', 'failed'), and the world-space bounding box of what
+  // is drawn for it ({ min, max }, null if nothing).
+  drawnShapes(name) {
+    const o = this.objects.get(name);
+    if (!o) return null;
+    o.root.updateWorldMatrix(true, true);
+    return o.drawn.map((d) => {
+      const box = new THREE.Box3();
+      for (const h of d.objects) box.expandByObject(h, true);
+      return {
+        kind: d.kind, link: d.link, frame: d.frame, state: d.state, error: d.error, texture: d.texture,
+        box: box.isEmpty() ? null : { min: box.min.toArray(), max: box.max.toArray() },
+      };
+    });
   }
 
   build(desc, key) {
@@ -123,37 +270,112 @@ export class SceneView {
       return g;
     });
     const frameByName = new Map(frames.map((g) => [g.name, g]));
-    (desc.shapes || []).forEach((s, shapeIndex) => {
-      let mesh;
-      if (s.kind === 'mesh' && s.mesh) {
-        // A box of the given size until the file is loaded, then the mesh scaled by size.
-        mesh = new THREE.Group();
-        mesh.scale.set(s.size[0], s.size[1], s.size[2]);
-        mesh.userData.object = desc.name;
-        const mat = material(s.color);
-        loadMesh(mesh, meshUrl(desc.name, shapeIndex, s.mesh), s.mesh, mat, (ok) => {
-          if (ok) this.meshes.loaded++;
-          else this.meshes.failed++;
-        });
-      } else if (s.kind === 'cylinder') {
-        mesh = new THREE.Mesh(unitCylinder, material(s.color));
-        mesh.scale.set(s.size[0], s.size[1], s.size[0]);
-        mesh.rotation.x = Math.PI / 2; // the model's cylinders run along z
-      } else if (s.kind === 'sphere') {
-        mesh = new THREE.Mesh(unitSphere, material(s.color));
-        mesh.scale.setScalar(s.size[0]);
-      } else {
-        // boxes, and meshes until their files are served: a box of the given size
-        mesh = new THREE.Mesh(unitBox, material(s.color));
-        mesh.scale.set(s.size[0], s.size[1], s.size[2]);
-      }
+    // Per shape, what is drawn for it: state 'primitive', 'loading', 'mesh', 'fallback' (the
+    // link's collision geometry) or 'placeholder', with the three.js objects and any error.
+    const drawn = [];
+    const problems = []; // { frame, text } shown next to the object
+    const fallbackLinks = new Set(); // links whose collision geometry is drawn already
+    const frameOf = (s) => frameByName.get(s.frame) || frames[0];
+    const placed = (s, child) => {
       const holder = new THREE.Group();
       holder.matrixAutoUpdate = false;
       holder.matrix.fromArray(s.pose);
-      holder.add(mesh);
-      (frameByName.get(s.frame) || frames[0]).add(holder);
+      holder.add(child);
+      child.traverse((c) => (c.userData.object = desc.name));
+      frameOf(s).add(holder);
+      return holder;
+    };
+    // A mesh (of a visual, or of a link's collision geometry) loaded into a group scaled by its size.
+    const meshGroup = (s, meshShape, onDone, mat = material(s.color)) => {
+      const g = new THREE.Group();
+      g.scale.set(s.size[0], s.size[1], s.size[2]);
+      g.userData.object = desc.name;
+      loadMesh(g, meshUrl(desc.name, meshShape, s.mesh), s.mesh, mat, materials, (error) => {
+        if (error) this.meshes.failed++;
+        else this.meshes.loaded++;
+        this.refit = true;
+        onDone(error);
+      });
+      return g;
+    };
+    const placeholder = (s, d) => {
+      const m = primitive({ kind: 'box', size: [PLACEHOLDER_SIZE, PLACEHOLDER_SIZE, PLACEHOLDER_SIZE] }, material(PLACEHOLDER_COLOR));
+      d.objects.push(placed(s, m));
+      d.state = 'placeholder';
+    };
+    // Mesh `shapeIndex` cannot be drawn: report it and draw the link's collision geometry instead
+    // (once per link), or a placeholder where the visual is.
+    const standIn = (s, shapeIndex, error) => {
+      const d = drawn[shapeIndex];
+      for (const h of d.objects) h.parent && h.parent.remove(h);
+      d.objects = [];
+      d.error = error;
+      const name = s.uri || s.mesh;
+      problems.push({ frame: s.frame, text: `${s.link ? `${s.link}: ` : ''}${name}: ${error}` });
+      if (this.onMeshFailed && !s.meshError) this.onMeshFailed(desc.name, shapeIndex, error);
+      const collision = s.fallback || [];
+      if (collision.length && !fallbackLinks.has(s.link)) {
+        fallbackLinks.add(s.link);
+        d.state = 'fallback';
+        for (const c of collision) {
+          if (c.kind === 'mesh') {
+            const g = meshGroup(c, c.meshShape, (e) => {
+              if (e) placeholder(c, d);
+            });
+            d.objects.push(placed(c, g));
+          } else {
+            d.objects.push(placed(c, primitive(c, material(c.color))));
+          }
+        }
+      } else if (collision.length) {
+        d.state = 'fallback'; // the link's collision geometry is drawn for another of its visuals
+      } else {
+        placeholder(s, d);
+      }
+      this.refit = true;
+    };
+    // A shape's material: its colour, and the URDF material's texture image (served as meshes are).
+    const shapeMaterial = (s, d) => {
+      const m = material(s.color);
+      if (!s.texture) return m;
+      const name = s.texture.uri;
+      if (s.texture.error) {
+        d.texture = 'failed';
+        problems.push({ frame: s.frame, text: `${s.link ? `${s.link}: ` : ''}texture ${name}: ${s.texture.error}` });
+        return m;
+      }
+      d.texture = 'loading';
+      new THREE.TextureLoader().load(meshUrl(desc.name, s.texture.meshShape, name), (t) => {
+        t.colorSpace = THREE.SRGBColorSpace;
+        m.map = t;
+        m.needsUpdate = true;
+        d.texture = 'drawn';
+      }, undefined, () => {
+        d.texture = 'failed';
+        problems.push({ frame: s.frame, text: `${s.link ? `${s.link}: ` : ''}texture ${name}: cannot be loaded` });
+        if (this.onMeshFailed) this.onMeshFailed(desc.name, s.texture.meshShape, 'the texture image cannot be loaded');
+      });
+      return m;
+    };
+    (desc.shapes || []).forEach((s, shapeIndex) => {
+      const d = { kind: s.kind, link: s.link || null, frame: s.frame, state: 'primitive', error: null, objects: [],
+        texture: null };
+      drawn.push(d);
+      if (s.kind === 'mesh' && s.meshError) {
+        standIn(s, shapeIndex, s.meshError);
+      } else if (s.kind === 'mesh' && s.mesh) {
+        d.state = 'loading';
+        const g = meshGroup(s, shapeIndex, (error) => {
+          if (error) standIn(s, shapeIndex, error);
+          else d.state = 'mesh';
+        }, shapeMaterial(s, d));
+        d.objects.push(placed(s, g));
+      } else {
+        d.objects.push(placed(s, primitive(s, shapeMaterial(s, d))));
+      }
     });
-    const o = { root, frames, desc, key, materials, bones: [], fingers: null };
+    if (desc.urdfError) problems.push({ frame: 'base', text: `URDF visuals: ${desc.urdfError}` });
+    const o = { root, frames, desc, key, materials, bones: [], fingers: null, drawn, problems, label: null };
     if (desc.kind === 'manipulator' && !desc.urdfVisuals) { // a URDF arm is drawn by its own visuals
       const linkMat = material([0.55, 0.6, 0.7, 1]);
       for (let i = 0; i + 1 < frames.length; ++i) {
@@ -223,6 +445,10 @@ export class SceneView {
         o.fingers[0].position.x = -half;
         o.fingers[1].position.x = half;
       }
+    }
+    if (this.refit && !this.userMoved) {
+      this.refit = false;
+      this.fitView();
     }
   }
 

@@ -150,6 +150,7 @@ const conn = new Connection({
   },
   onError: notify,
 });
+view.onMeshFailed = (object, shape, message) => conn.meshFailed(object, shape, message).catch(() => {});
 setInterval(() => conn.connected && send('read'), 500);
 
 window.rp = {

@@ -5,13 +5,18 @@
 #include "rp/manipulator/DefaultManipulator.hpp"
 #include "rp/model/UrdfModel.hpp"
 
+#include <string>
+#include <vector>
+
 namespace rp {
 
 /// Any serial arm from a URDF file (see loadUrdf()), with a DefaultPositionControl and gravity
 /// compensation on, simulated from the file's inertias.
 ///
 /// rp.cfg settings besides Table 1's: `urdf FILE` (relative paths are relative to the rp.cfg
-/// file's folder) and `tip LINK` (default: the last movable link of an unbranched chain).
+/// file's folder), `tip LINK` (default: the last movable link of an unbranched chain) and
+/// `packagePath DIR[:DIR...]` (folders holding the packages of the URDF's `package://` mesh files,
+/// searched before `ROS_PACKAGE_PATH`; relative folders are relative to the rp.cfg file's folder).
 class UrdfManipulator : public DefaultManipulator {
  public:
   /// Creates the arm and starts its servo loop.
@@ -21,7 +26,7 @@ class UrdfManipulator : public DefaultManipulator {
   /// @throws UrdfError for a bad file; std::invalid_argument if no URDF file is given
   explicit UrdfManipulator(const std::string& name = "", const std::string& urdfFile = "", const std::string& tip = "");
   ~UrdfManipulator() override;
-  /// Declares `urdf` and `tip`.
+  /// Declares `urdf`, `tip` and `packagePath`.
   /// @param[out] schema  schema to add to
   static void declareSettings(SettingSchema& schema);
   /// The URDF file the arm was loaded from (after rp.cfg's `urdf` setting, relative paths
@@ -29,6 +34,9 @@ class UrdfManipulator : public DefaultManipulator {
   const std::string& getUrdfFile() const { return urdfFile_; }
   /// The tip link asked for (rp.cfg's `tip` or the constructor's); empty for the default.
   const std::string& getTip() const { return tip_; }
+  /// The folders of rp.cfg's `packagePath` setting (absolute; empty without the setting), where
+  /// the Scene Viewer looks first for the URDF's `package://` mesh files (see resolveMeshUri()).
+  std::vector<std::string> getPackagePath() const;
 
  private:
   std::string urdfFile_, tip_;
