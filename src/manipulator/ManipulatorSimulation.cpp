@@ -398,6 +398,17 @@ void ManipulatorSimulation::declareSettings(SettingSchema& schema) {
   perJointNumbers("simInitialVelocity", "deg/s or mm/s",
                   "simulated arm: initial joint velocities (one per joint; revolute in deg/s, prismatic in mm/s)",
                   -1e6, 1e6);
+  schema.setDefault("integrator", "rk4");
+  schema.setDefault("simMassScale", "1");
+  schema.setDefault("simInertiaScale", "1");
+  schema.setDefault("simFrictionScale", "1");
+  schema.setDefault("simPayload", "0");
+  schema.setDefault("simCountsPerRadian", "(none: exact readings)");
+  schema.setDefault("simSensorDelay", "0");
+  schema.setDefault("simFriction", "on");
+  schema.setDefault("simMotorInertia", "on");
+  schema.setDefault("simInitialPosition", "(the model's home position)");
+  schema.setDefault("simInitialVelocity", "0");
 }
 
 std::unique_ptr<ManipulatorSimulation> makeSimulation(const ManipulatorModel& nominal, const ConfigSection* section) {

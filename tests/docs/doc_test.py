@@ -13,7 +13,7 @@ Like Rust's doctests, the text users copy from is what CI runs. Each block is on
   ```cmake```                   <!-- doc-test: cmake --> the lines a user adds to their project
   ```sh```                      each command line run (continuations joined, comments dropped)
                                 in a scratch folder with the installed bin/ first on PATH, `build`
-                                linking to the build tree, `scripts` and `tests` to the source
+                                linking to the build tree, `scripts`, `tests` and `examples` to the source
                                 tree's; exit status 0.
                                 <!-- doc-test: server -->: each command must still run after 2 s
                                 and end with status 0 on SIGTERM; `rp.cfg above` in the annotation:
@@ -288,6 +288,7 @@ class DocTest:
         os.symlink(self.build, os.path.join(d, "build"))
         os.symlink(os.path.join(self.src, "scripts"), os.path.join(d, "scripts"))
         os.symlink(os.path.join(self.src, "tests"), os.path.join(d, "tests"))  # fixtures of output samples
+        os.symlink(os.path.join(self.src, "examples"), os.path.join(d, "examples"))  # the example programs' sources
         os.makedirs(os.path.join(d, "docs", "images", "trajectories"))
 
     def write_rpcfg_above(self, b, blocks, d):
