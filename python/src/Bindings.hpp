@@ -3,6 +3,8 @@
 
 #include <pybind11/pybind11.h>
 
+#include <memory>
+
 namespace rp {
 class ManipulatorModel;
 }
@@ -20,5 +22,7 @@ void bindPlatform(pybind11::module_& m);
 void bindTrajectories(pybind11::module_& m);
 /// The model of a Python Model object (Models.cpp); a TypeError for anything else.
 const ManipulatorModel& modelOf(const pybind11::handle& object);
+/// The same model, shared (the Python object may go before whoever keeps it).
+std::shared_ptr<const ManipulatorModel> sharedModelOf(const pybind11::handle& object);
 
 }  // namespace rp::python

@@ -135,6 +135,10 @@ JointVector row(const py::array_t<double, py::array::c_style>& a, py::ssize_t r,
 
 const ManipulatorModel& modelOf(const py::handle& object) { return *object.cast<const PyModel&>().model; }
 
+std::shared_ptr<const ManipulatorModel> sharedModelOf(const py::handle& object) {
+  return object.cast<const PyModel&>().model;
+}
+
 py::object makeModelCopy(const ManipulatorModel& model) {
   return py::cast(std::make_unique<PyModel>(std::make_shared<ManipulatorModel>(model)));
 }
@@ -357,8 +361,10 @@ void bindModels(py::module_& m) {
           [](const PyModel& p, const py::handle& poses, const py::object& seeds, double positionTolerance,
              double orientationTolerance, int maxAttempts) {
             const int n = p.dof();
-            py::array_t<double, py::array::c_style | py::array::forcecast> a =
-                py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(poses);
+            const py::array raw = py::array::ensure(poses);
+            if (!raw || (raw.dtype().kind() != 'f' && raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u'))
+              throw py::value_error("poses: expected real numbers (float64) of shape (N, 4, 4)");
+            const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(raw);
             if (!a || a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
               throw py::value_error("poses: expected an array of shape (N, 4, 4)");
             const py::ssize_t rows = a.shape(0);

@@ -17,20 +17,49 @@ namespace rp::python {
 
 namespace {
 
-// A manipulator the module made (owned) or one the ObjectManager made (not owned).
+// A manipulator the module made (owned) or one the ObjectManager made (owned by the manager: a
+// shared pointer that deletes nothing). Calls that release the GIL take a copy of the pointer
+// first, so close() in another thread never frees an arm under them.
 struct PyManipulator {
-  std::unique_ptr<DefaultManipulator> owned;
-  DefaultManipulator* arm = nullptr;
+  std::shared_ptr<DefaultManipulator> arm;
   py::object generator;  // the Python generator set on it: kept alive while the arm uses it
 
-  DefaultManipulator& get() const {
-    if (arm == nullptr) throw std::runtime_error("the manipulator was destroyed");
-    return *arm;
+  ~PyManipulator() { close(); }
+  // The arm, or RuntimeError once closed. Hold the result across a released GIL.
+  std::shared_ptr<DefaultManipulator> ptr() const {
+    if (!arm) throw std::runtime_error("the manipulator was closed");
+    return arm;
   }
+  DefaultManipulator& get() const { return *ptr(); }
   int dof() const { return get().getNumberOfJoints(); }
+  // Destroys an owned arm (holding a moving arm until at rest) without the GIL, then lets the
+  // generator go: the arm has disconnected it by then.
+  void close() {
+    std::shared_ptr<DefaultManipulator> last = std::move(arm);
+    if (last) {
+      py::gil_scoped_release release;
+      last.reset();
+    }
+    generator = py::object();
+  }
+};
+
+// Deletes with the GIL released: a generator's destructor waits until its motions have run.
+struct ReleaseGilDeleter {
+  template <typename T>
+  void operator()(T* p) const {
+    py::gil_scoped_release release;
+    delete p;
+  }
 };
 
 using Generator = DefaultTrajectoryGenerator<Dynamic>;
+
+// The joints of the generator's arm, or the length of the target when it has none yet.
+int jointsOf(const Generator& g, const py::handle& target) {
+  const std::vector<Manipulator*> arms = g.getManipulators();  // one copy
+  return arms.empty() ? static_cast<int>(py::len(target)) : arms.front()->getNumberOfJoints();
+}
 
 SimulatedClock& simulatedClock() {
   auto* clock = dynamic_cast<SimulatedClock*>(&RoboticPlatform::getDefaultClock());
@@ -48,11 +77,20 @@ DefaultManipulator* firstManipulator() {
 template <typename Arm, typename... Args>
 std::unique_ptr<PyManipulator> make(Args&&... args) {
   auto p = std::make_unique<PyManipulator>();
+  py::gil_scoped_release release;  // construction starts a servo loop
+  p->arm = std::make_shared<Arm>(std::forward<Args>(args)...);
+  return p;
+}
+
+std::unique_ptr<PyManipulator> fromManager(ObjectManager& om, const std::string& name) {
+  DefaultManipulator* arm = nullptr;
   {
-    py::gil_scoped_release release;  // construction starts a servo loop
-    p->owned = std::make_unique<Arm>(std::forward<Args>(args)...);
+    py::gil_scoped_release release;
+    arm = om.createDerivedObject<DefaultManipulator>(name);
   }
-  p->arm = p->owned.get();
+  if (arm == nullptr) throw std::invalid_argument("object '" + name + "' is not a manipulator");
+  auto p = std::make_unique<PyManipulator>();
+  p->arm = std::shared_ptr<DefaultManipulator>(arm, [](DefaultManipulator*) {});  // the manager owns it
   return p;
 }
 
@@ -83,7 +121,8 @@ void bindPlatform(py::module_& m) {
       "step",
       [](std::uint64_t cycles, PyManipulator* arm) {
         simulatedClock();
-        DefaultManipulator& m = arm != nullptr ? arm->get() : *firstManipulator();
+        std::shared_ptr<DefaultManipulator> keep = arm != nullptr ? arm->ptr() : nullptr;
+        DefaultManipulator& m = keep ? *keep : *firstManipulator();
         bool ok = false;
         {
           py::gil_scoped_release release;
@@ -100,21 +139,18 @@ void bindPlatform(py::module_& m) {
   m.def("is_shutdown_requested", [] { return ObjectManager::isShutdownRequested(); });
   m.def("shutdown_reason", [] { return ObjectManager::getShutdownReason(); });
 
-  py::class_<Generator>(m, "TrajectoryGenerator",
+  py::class_<Generator, std::unique_ptr<Generator, ReleaseGilDeleter>>(m, "TrajectoryGenerator",
                         "The paper's DefaultTrajectoryGenerator: queued jerk-limited joint and Cartesian motions. "
                         "Destroying it waits until its motions have run.")
-      .def(py::init([](const std::string& name) { return std::make_unique<Generator>(name); }), py::arg("name") = "")
+      .def(py::init([](const std::string& name) { return std::unique_ptr<Generator, ReleaseGilDeleter>(new Generator(name)); }),
+           py::arg("name") = "")
       .def("move", [](Generator& g, const py::handle& degrees) {
-             const JointVector d = toVector(degrees, g.getManipulators().empty() ? static_cast<int>(py::len(degrees))
-                                                                                  : g.getManipulators()[0]->getNumberOfJoints(),
-                                            "target");
+             const JointVector d = toVector(degrees, jointsOf(g, degrees), "target");
              py::gil_scoped_release release;
              g.move(d);
            }, py::arg("target_degrees"), "queues a joint motion to a target in degrees (the paper's move())")
       .def("move_radians", [](Generator& g, const py::handle& q) {
-             const JointVector r = toVector(q, g.getManipulators().empty() ? static_cast<int>(py::len(q))
-                                                                            : g.getManipulators()[0]->getNumberOfJoints(),
-                                            "target");
+             const JointVector r = toVector(q, jointsOf(g, q), "target");
              py::gil_scoped_release release;
              g.moveRadians(r);
            }, py::arg("target"), "queues a joint motion to a target in radians")
@@ -137,10 +173,17 @@ void bindPlatform(py::module_& m) {
              return g.waitUntilDone(timeout);
            }, py::arg("timeout") = -1.0, "waits until every queued motion has run; False on time-out or a shutdown")
       .def("is_done", &Generator::isDone)
-      .def("set_speed_fraction", &Generator::setSpeedFraction, py::arg("fraction"))
-      .def("set_joint_blend_radius", &Generator::setJointBlendRadius, py::arg("radians"))
-      .def("set_cartesian_blend_radius", &Generator::setCartesianBlendRadius, py::arg("metres"))
-      .def_property_readonly("blend_count", &Generator::getBlendCount);
+      // These wait for the generator's planning lock, which a queueing thread may hold: without the GIL.
+      .def("set_speed_fraction", &Generator::setSpeedFraction, py::arg("fraction"),
+           py::call_guard<py::gil_scoped_release>())
+      .def("set_joint_blend_radius", &Generator::setJointBlendRadius, py::arg("radians"),
+           py::call_guard<py::gil_scoped_release>())
+      .def("set_cartesian_blend_radius", &Generator::setCartesianBlendRadius, py::arg("metres"),
+           py::call_guard<py::gil_scoped_release>())
+      .def_property_readonly("blend_count", [](const Generator& g) {
+             py::gil_scoped_release release;
+             return g.getBlendCount();
+           });
 
   py::class_<PyManipulator>(m, "Manipulator",
                             "A manipulator whose servo loop runs in C++ (DefaultManipulator): in simulation mode, "
@@ -170,12 +213,14 @@ void bindPlatform(py::module_& m) {
            }, py::arg("wrench"), "force [N] and moment [N m] on the simulated end-effector, in world coordinates")
       .def("set_transform", [](const PyManipulator& p, const py::handle& pose) {
              const Transform t = toTransform(pose, "pose");
+             const auto arm = p.ptr();
              py::gil_scoped_release release;
-             p.get().setTransform(t);
+             arm->setTransform(t);
            }, py::arg("pose"))
       .def("set_simulation_mode", [](const PyManipulator& p, bool on) {
+             const auto arm = p.ptr();
              py::gil_scoped_release release;
-             on ? p.get().setSimulationModeOn() : p.get().setSimulationModeOff();
+             on ? arm->setSimulationModeOn() : arm->setSimulationModeOff();
            }, py::arg("on"))
       .def_property_readonly("simulation_mode", [](const PyManipulator& p) { return p.get().isSimulationModeOn(); })
       .def_property_readonly("uses_hardware", [](const PyManipulator& p) { return p.get().usesHardware(); })
@@ -198,31 +243,28 @@ void bindPlatform(py::module_& m) {
            })
       .def("set_trajectory_generator", [](PyManipulator& p, py::object generator) {
              Generator& g = generator.cast<Generator&>();
+             const auto arm = p.ptr();
              {
                py::gil_scoped_release release;
-               p.get().setTrajectoryGenerator(g);
+               arm->setTrajectoryGenerator(g);
              }
              p.generator = std::move(generator);
            }, py::arg("generator"), "connects a TrajectoryGenerator (kept alive while connected)")
       .def("clear_trajectory_generator", [](PyManipulator& p) {
+             const auto arm = p.ptr();
              {
                py::gil_scoped_release release;
-               p.get().clearTrajectoryGenerator();
+               arm->clearTrajectoryGenerator();
              }
              p.generator = py::none();
            })
       .def("run_cycles", [](const PyManipulator& p, std::uint64_t cycles) {
+             const auto arm = p.ptr();
              py::gil_scoped_release release;
-             return p.get().runCycles(cycles);
+             return arm->runCycles(cycles);
            }, py::arg("cycles"), "runs exactly this many servo cycles (simulated clock: then pauses it)")
-      .def("close", [](PyManipulator& p) {
-             if (p.owned) {
-               py::gil_scoped_release release;
-               p.owned.reset();  // holds a moving arm until at rest, powers it off
-             }
-             p.arm = nullptr;
-             p.generator = py::none();
-           }, "destroys the manipulator now (holding a moving arm until at rest first)");
+      .def("close", &PyManipulator::close,
+           "destroys the manipulator now (holding a moving arm until at rest first); later calls raise RuntimeError");
 
   m.def("Puma560", [](const std::string& name) { return make<Puma560>(name); }, py::arg("name") = "",
         "A Puma 560 (simulated unless -nosim and rp.cfg give it a hardware server).");
@@ -231,11 +273,11 @@ void bindPlatform(py::module_& m) {
           return make<UrdfManipulator>(name, urdf, tip);
         }, py::arg("name") = "", py::arg("urdf") = "", py::arg("tip") = "");
 
-  py::class_<DefaultGripper>(m, "DefaultGripper",
+  py::class_<DefaultGripper, std::unique_ptr<DefaultGripper, ReleaseGilDeleter>>(m, "DefaultGripper",
                              "The paper's DefaultGripper: open/close through an I/O board, or simulated.")
       .def(py::init([](const std::string& name) {
              py::gil_scoped_release release;
-             return std::make_unique<DefaultGripper>(name);
+             return std::unique_ptr<DefaultGripper, ReleaseGilDeleter>(new DefaultGripper(name));
            }),
            py::arg("name") = "")
       .def("open", [](DefaultGripper& g) {
@@ -254,24 +296,9 @@ void bindPlatform(py::module_& m) {
 
   py::class_<ObjectManager>(m, "ObjectManager", "The paper's object manager.")
       .def(py::init<>())
-      .def("create_derived_object", [](ObjectManager& om, const std::string& name) {
-             auto p = std::make_unique<PyManipulator>();
-             {
-               py::gil_scoped_release release;
-               p->arm = om.createDerivedObject<DefaultManipulator>(name);
-             }
-             if (p->arm == nullptr) throw std::invalid_argument("object '" + name + "' is not a manipulator");
-             return p;
-           }, py::arg("name"), "creates the manipulator rp.cfg's section [name] describes (owned by the manager)")
-      .def("createDerivedObject", [](ObjectManager& om, const std::string& name) {
-             auto p = std::make_unique<PyManipulator>();
-             {
-               py::gil_scoped_release release;
-               p->arm = om.createDerivedObject<DefaultManipulator>(name);
-             }
-             if (p->arm == nullptr) throw std::invalid_argument("object '" + name + "' is not a manipulator");
-             return p;
-           }, py::arg("name"), "the paper's spelling of create_derived_object()");
+      .def("create_derived_object", &fromManager, py::arg("name"),
+           "creates the manipulator rp.cfg's section [name] describes (owned by the manager)")
+      .def("createDerivedObject", &fromManager, py::arg("name"), "the paper's spelling of create_derived_object()");
 }
 
 }  // namespace rp::python

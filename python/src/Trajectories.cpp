@@ -41,6 +41,9 @@ void bindTrajectories(py::module_& m) {
           starts.push_back(starts.back() + segments.back().getDuration());
         }
         const double duration = starts.back();
+        if (!(duration * rate <= 1e7))
+          throw py::value_error("plan_joint_motion: more than 1e7 samples (" + std::to_string(duration) + " s at " +
+                                std::to_string(rate) + " Hz); lower the rate");
         const auto samples = static_cast<py::ssize_t>(std::floor(duration * rate + 1e-9)) + 1;
         py::array_t<double> t(samples), q({samples, py::ssize_t{n}}), qd({samples, py::ssize_t{n}}),
             qdd({samples, py::ssize_t{n}});
@@ -78,10 +81,10 @@ void bindTrajectories(py::module_& m) {
                              "motions as on rp.TrajectoryGenerator (move, move_radians, move_to, dwell, blend radii, "
                              "speed fraction), then sample(rate).")
       .def(py::init([](const py::handle& modelObject, const py::object& start) {
-             const ManipulatorModel& model = modelOf(modelObject);
-             const JointVector q = start.is_none() ? model.getHomePosition()
-                                                   : toVector(start, model.getNumberOfJoints(), "start");
-             return std::make_unique<OfflinePlanner>(model, q);
+             std::shared_ptr<const ManipulatorModel> model = sharedModelOf(modelObject);
+             const JointVector q = start.is_none() ? model->getHomePosition()
+                                                   : toVector(start, model->getNumberOfJoints(), "start");
+             return std::make_unique<OfflinePlanner>(std::move(model), q);
            }),
            py::arg("model"), py::arg("start") = py::none())
       .def("move", [](OfflinePlanner& p, const py::handle& degrees) {

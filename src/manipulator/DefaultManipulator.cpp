@@ -13,6 +13,7 @@
 #include "rp/core/ObjectManager.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/io/HwServerIoBoard.hpp"
+#include "rp/io/IoException.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/rt/Clock.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
@@ -65,6 +66,7 @@ constexpr double kRestVelocity = 1e-3;  // [rad/s] below which the arm counts as
 constexpr double kRestDuration = 0.05;  // [s] at rest before the power goes off in a shutdown
 constexpr double kShutdownTimeout = 3.0;  // [s] longest damped hold
 constexpr int kMaxCatchUpSteps = 1000;    // longest stall the simulation integrates, in periods
+constexpr double kSwitchRestVelocity = 0.01;  // [rad/s] at rest enough to leave the hardware
 
 int firstNonFinite(const JointVector& v) {
   for (int i = 0; i < v.size(); ++i)
@@ -123,6 +125,27 @@ void DefaultManipulator::install(Setup& setup) noexcept {
   modelView_.store(model_.get(), std::memory_order_release);
 }
 
+DefaultManipulator::SetupResult DefaultManipulator::checkSetup(const Setup& setup) const noexcept {
+  // In the servo thread, between cycles: what the caller checked may have changed since.
+  if (shutdownPhase_.load(std::memory_order_acquire) != 0 || loopEnded_.load()) return SetupResult::kShutdown;
+  if (generator_.load(std::memory_order_acquire) != nullptr ||
+      servoControl_.load(std::memory_order_acquire) != defaultControl_.get() ||
+      zeroGravity_.load(std::memory_order_relaxed)) {
+    return SetupResult::kDriven;
+  }
+  // Leaving the hardware switches its amplifiers off: only with the arm at rest.
+  if (board_ != nullptr && !setup.keepBoard && power_ && qd_.cwiseAbs().maxCoeff() > kSwitchRestVelocity)
+    return SetupResult::kMoving;
+  // The new hardware must answer before it takes over.
+  if (setup.board != nullptr) {
+    for (int i = 0; i < q_.size(); ++i) {
+      std::int64_t counts = 0;
+      if (setup.board->readEncoder(i, counts) != IoStatus::kOk) return SetupResult::kHardwareFailed;
+    }
+  }
+  return SetupResult::kApplied;
+}
+
 void DefaultManipulator::applySetup(Setup& setup) noexcept {
   if (board_ != nullptr && !setup.keepBoard) writeOutputsOff();  // leaving this hardware: amplifiers off, 0 V
   install(setup);
@@ -169,10 +192,14 @@ void DefaultManipulator::physicalSetupChanged() {
     throw std::logic_error("manipulator '" + getName() +
                            "': the pose, mount and simulation mode cannot change during or after a shutdown");
   }
-  if (generator_.load() != nullptr || servoControl_.load() != defaultControl_.get()) {
+  if (inServoThread() || ControlProgram::isLoopThread()) {
+    throw std::logic_error("manipulator '" + getName() +
+                           "': the pose, mount and simulation mode cannot change from inside a control loop");
+  }
+  if (generator_.load() != nullptr || servoControl_.load() != defaultControl_.get() || zeroGravity_.load()) {
     throw std::logic_error("manipulator '" + getName() +
                            "': set the pose, mount and simulation mode before a trajectory generator or a servo "
-                           "control of the program drives the arm (clear them first)");
+                           "control of the program drives the arm, and not in zero-gravity mode (clear them first)");
   }
   if (!simulation && builtForSimulation_) {
     const ConfigSection* section = configSection();
@@ -180,8 +207,12 @@ void DefaultManipulator::physicalSetupChanged() {
   }
   std::unique_ptr<Setup> setup = makeSetup(simulation, base);  // may throw: nothing changed yet
   if (!isRunning()) {
-    applySetup(*setup);  // no servo thread (a derived constructor): apply here
-    for (int i = 0; i < initial_.n; ++i) initial_.q[i] = initial_.qdes[i] = q_(i);
+    // No servo thread (a derived constructor): checked and applied here.
+    setupResult_.store(static_cast<int>(checkSetup(*setup)));
+    if (setupResult_.load() == static_cast<int>(SetupResult::kApplied)) {
+      applySetup(*setup);
+      for (int i = 0; i < initial_.n; ++i) initial_.q[i] = initial_.qdes[i] = q_(i);
+    }
   } else {
     // The servo thread takes it between two cycles; a paused simulated clock is stepped until it has.
     Setup* handed = setup.get();
@@ -204,6 +235,22 @@ void DefaultManipulator::physicalSetupChanged() {
         std::this_thread::sleep_for(std::chrono::microseconds(200));
       }
     }
+  }
+  switch (static_cast<SetupResult>(setupResult_.load(std::memory_order_acquire))) {
+    case SetupResult::kApplied:
+      break;
+    case SetupResult::kShutdown:
+      throw std::logic_error("manipulator '" + getName() +
+                             "': the pose, mount and simulation mode cannot change during or after a shutdown");
+    case SetupResult::kDriven:
+      throw std::logic_error("manipulator '" + getName() +
+                             "': set the pose, mount and simulation mode before a trajectory generator or a servo "
+                             "control of the program drives the arm, and not in zero-gravity mode (clear them first)");
+    case SetupResult::kMoving:
+      throw std::logic_error("manipulator '" + getName() +
+                             "': the arm must be at rest to leave the hardware (its amplifiers go off)");
+    case SetupResult::kHardwareFailed:
+      throw IoException("manipulator '" + getName() + "': the hardware server does not answer: cannot read the joints");
   }
   builtForSimulation_ = simulation;
   builtBase_ = base;
@@ -553,7 +600,9 @@ void DefaultManipulator::control() {
   // A change of pose or simulation mode (physicalSetupChanged()) takes effect between cycles.
   if (pendingSetup_.load(std::memory_order_relaxed) != nullptr) {
     if (Setup* setup = pendingSetup_.exchange(nullptr, std::memory_order_acq_rel)) {
-      applySetup(*setup);
+      const SetupResult result = checkSetup(*setup);
+      if (result == SetupResult::kApplied) applySetup(*setup);
+      setupResult_.store(static_cast<int>(result), std::memory_order_relaxed);
       appliedSetup_.store(setup, std::memory_order_release);
     }
   }
@@ -564,9 +613,9 @@ void DefaultManipulator::control() {
     // Real time, whatever the loop's clock: the program's own thread must get to run.
     const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
     if (noHardwareSince_ < 0) noHardwareSince_ = now;
-    if (isSimulationModeOn()) {
-      noHardware_.store(false, std::memory_order_relaxed);
-    } else if (now - noHardwareSince_ > 0.5 && shutdownPhase_.load() == 0) {
+    // (setSimulationModeOn() ends the wait through physicalSetupChanged(), which installs a
+    // simulation; only that clears noHardware_.)
+    if (now - noHardwareSince_ > 0.5 && shutdownPhase_.load() == 0) {
       std::snprintf(errorBuffer_, sizeof errorBuffer_,
                     "%.60s: simulation mode is off but no hardware is configured for it (rp.cfg 'hwserver NAME', "
                     "or simulation on)", nameBuffer_);

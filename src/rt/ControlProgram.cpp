@@ -477,6 +477,8 @@ void ControlProgram::waitUntilStopped() {
   stop();
 }
 
+bool ControlProgram::isLoopThread() noexcept { return internal::currentLoop != nullptr; }
+
 bool ControlProgram::isRunning() const noexcept { return impl_->running.load(); }
 double ControlProgram::getTime() const noexcept { return impl_->time.load(std::memory_order_relaxed); }
 std::uint64_t ControlProgram::getCycleCount() const noexcept { return impl_->cycles.load(std::memory_order_relaxed); }

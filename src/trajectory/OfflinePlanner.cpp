@@ -1,12 +1,14 @@
 // Planning and sampling without an arm (rp/trajectory/OfflinePlanner.hpp).
 #include "rp/trajectory/OfflinePlanner.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "rp/manipulator/Manipulator.hpp"
 #include "rp/model/Kinematics.hpp"
+#include "rp/model/Puma560Model.hpp"
 
 namespace rp {
 
@@ -14,14 +16,15 @@ namespace rp {
 // its model, its joint position (the start) and its period.
 class OfflinePlanner::Arm : public Manipulator {
  public:
-  Arm(const ManipulatorModel& model, const JointVector& start) : model_(model), data_(model_), q_(start) {
+  Arm(std::shared_ptr<const ManipulatorModel> model, const JointVector& start)
+      : model_(std::move(model)), data_(*model_), q_(start) {
     setpoint_.position = start;
     setpoint_.velocity = JointVector::Zero(start.size());
     setpoint_.acceleration = JointVector::Zero(start.size());
   }
   ~Arm() override { withdrawObject(); }
 
-  const ManipulatorModel& getModel() const override { return model_; }
+  const ManipulatorModel& getModel() const override { return *model_; }
   double getServoPeriod() const override { return 1e-3; }
   JointVector getJointPosition() const override { return q_; }
   JointVector getJointVelocity() const override { return JointVector::Zero(q_.size()); }
@@ -31,10 +34,10 @@ class OfflinePlanner::Arm : public Manipulator {
   void enableArmPower() override { refuse("enableArmPower"); }
   void disableArmPower() override {}
   bool isArmPowerOn() const override { return false; }
-  Transform getEndEffectorTransform() const override { return forwardKinematics(model_, data_, q_); }
+  Transform getEndEffectorTransform() const override { return forwardKinematics(*model_, data_, q_); }
   void endEffectorForceToJointTorque(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& force,
                                      Eigen::Ref<Eigen::VectorXd> torque) const override {
-    rp::endEffectorForceToJointTorque(model_, data_, JointVector(q), force, torque, ReferenceFrame::Base);
+    rp::endEffectorForceToJointTorque(*model_, data_, JointVector(q), force, torque, ReferenceFrame::Base);
   }
   void setTrajectoryGenerator(TrajectoryGenerator& generator) override {
     generator.attach(*this);
@@ -67,7 +70,7 @@ class OfflinePlanner::Arm : public Manipulator {
     generator_ = nullptr;
   }
 
-  ManipulatorModel model_;
+  std::shared_ptr<const ManipulatorModel> model_;
   mutable ManipulatorData data_;
   JointVector q_;
   Setpoint setpoint_;
@@ -80,14 +83,28 @@ class OfflinePlanner::Generator : public DefaultTrajectoryGenerator<> {
   using QueueTrajectoryGenerator::queueDwell;
 };
 
-OfflinePlanner::OfflinePlanner(const ManipulatorModel& model, const JointVector& start) {
+namespace {
+// A copy that keeps the model's class where the generator looks at it (the Puma's closed-form IK).
+std::shared_ptr<const ManipulatorModel> copyOf(const ManipulatorModel& model) {
+  if (const auto* puma = dynamic_cast<const Puma560Model*>(&model)) return std::make_shared<Puma560Model>(*puma);
+  return std::make_shared<ManipulatorModel>(model);
+}
+constexpr double kMaxSamples = 1e7;
+}  // namespace
+
+OfflinePlanner::OfflinePlanner(const ManipulatorModel& model, const JointVector& start)
+    : OfflinePlanner(copyOf(model), start) {}
+
+OfflinePlanner::OfflinePlanner(std::shared_ptr<const ManipulatorModel> shared, const JointVector& start) {
+  if (!shared) throw std::invalid_argument("OfflinePlanner: no model");
+  const ManipulatorModel& model = *shared;
   const int n = model.getNumberOfJoints();
   if (start.size() != n)
     throw std::invalid_argument("OfflinePlanner: the start has " + std::to_string(start.size()) + " values for " +
                                 std::to_string(n) + " joints");
   if (!start.allFinite() || !model.isWithinLimits(start))
     throw std::invalid_argument("OfflinePlanner: the start is outside the joint limits of '" + model.getName() + "'");
-  arm_ = std::make_unique<Arm>(model, start);
+  arm_ = std::make_unique<Arm>(std::move(shared), start);
   generator_ = std::make_unique<Generator>();
   arm_->setTrajectoryGenerator(*generator_);
 }
@@ -97,7 +114,7 @@ OfflinePlanner::~OfflinePlanner() {
   // for it), in growing steps: the setpoints are not needed.
   Setpoint sp = arm_->getSetpoint();
   double step = 1.0;
-  for (int i = 0; i < 10000 && !generator_->isDone(); ++i, step *= 1.5) {
+  for (int i = 0; i < 1000 && !generator_->isDone(); ++i, step = std::min(step * 1.5, 1e6)) {
     time_ += step;
     generator_->getCurrentSetpoint(time_, sp);
   }
@@ -122,6 +139,10 @@ void OfflinePlanner::dwell(double seconds) {
 OfflinePlanner::Samples OfflinePlanner::sample(double rate, double maxDuration) {
   if (!(rate > 0) || !std::isfinite(rate)) throw std::invalid_argument("OfflinePlanner::sample: the rate must be positive");
   const int n = arm_->getModel().getNumberOfJoints();
+  if (maxDuration * rate > kMaxSamples)
+    throw std::length_error("OfflinePlanner::sample: more than 1e7 samples (" + std::to_string(maxDuration) + " s at " +
+                            std::to_string(rate) + " Hz); lower the rate or the longest duration");
+  if (generator_->isDone()) return {};  // nothing queued since the last call
   Setpoint sp = arm_->getSetpoint();
   std::vector<double> times;
   std::vector<JointVector> q, qd, qdd;

@@ -115,6 +115,10 @@ TEST_F(PoseAndMode, AChangeWhileSomethingDrivesTheArmIsRefusedAndUndone) {
     EXPECT_EQ(puma.getConnection(), nullptr);
     puma.releaseServoControl(control);
   }
+  // Zero-gravity mode (someone may be guiding the arm by hand) is refused too.
+  puma.setZeroGravityModeOn();
+  EXPECT_THROW(puma.setTransform(translation(1, 0, 0)), std::logic_error);
+  puma.setZeroGravityModeOff();
   // Nothing drives it any more: the change is taken.
   puma.setTransform(translation(1, 0, 0));
   EXPECT_LT(maxDifference(puma.getModel().getBaseTransform(), Transform(translation(1, 0, 0) * base0)), 1e-12);
@@ -197,6 +201,25 @@ TEST(PoseAndModeHardware, ASimulatedArmSwitchesToTheHardwareAndBackLeavingItsOut
     for (int i = 0; i < 6; ++i) EXPECT_NEAR(held(i), home(i), 0.01) << "joint " << i + 1;
     EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
 
+    // Moving: leaving the hardware (its amplifiers off) is refused until the arm is at rest.
+    {
+      test::JointRamp ramp(0, 0.3);
+      puma.setTrajectoryGenerator(ramp);
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      puma.clearTrajectoryGenerator();
+      try {
+        puma.setSimulationModeOn();
+        ADD_FAILURE() << "left the hardware while the arm moved at " << puma.getJointVelocity()(0) << " rad/s";
+      } catch (const std::logic_error& e) {
+        EXPECT_NE(std::string(e.what()).find("at rest"), std::string::npos) << e.what();
+      }
+      EXPECT_TRUE(puma.usesHardware());
+      EXPECT_FALSE(puma.isSimulationModeOn()) << "the refused mode is undone";
+      EXPECT_TRUE(amplifiersOn());
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the default control stops it
+    }
+    const JointVector stopped = puma.getJointPosition();
+
     const std::uint64_t trips = monitor.watchdogTrips();
     puma.setSimulationModeOn();
     // Switched off by the program as the call returned (applied at the server's next tick), not
@@ -205,9 +228,9 @@ TEST(PoseAndModeHardware, ASimulatedArmSwitchesToTheHardwareAndBackLeavingItsOut
     EXPECT_EQ(monitor.watchdogTrips(), trips);
     EXPECT_FALSE(puma.usesHardware());
     // The simulation takes over where the hardware arm was, and holds.
-    EXPECT_LT((puma.getJointPosition() - held).cwiseAbs().maxCoeff(), 0.01);
+    EXPECT_LT((puma.getJointPosition() - stopped).cwiseAbs().maxCoeff(), 0.01);
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    EXPECT_LT((puma.getJointPosition() - held).cwiseAbs().maxCoeff(), 0.01);
+    EXPECT_LT((puma.getJointPosition() - stopped).cwiseAbs().maxCoeff(), 0.01);
     EXPECT_TRUE(outputsOff());
     EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
   }

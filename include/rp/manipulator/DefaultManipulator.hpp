@@ -194,7 +194,9 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   struct WrenchBox;
   struct Setup;  // what is built from the pose and the simulation mode
 
+  enum class SetupResult { kApplied, kShutdown, kDriven, kMoving, kHardwareFailed };
   std::unique_ptr<Setup> makeSetup(bool simulation, const Transform& base) const;
+  SetupResult checkSetup(const Setup& setup) const noexcept;  // in the servo thread, before applySetup()
   void install(Setup& setup) noexcept;     // swaps the setup's parts with the manipulator's
   void applySetup(Setup& setup) noexcept;  // in the servo thread between cycles: install and carry the state over
   void applyWrenches(int n);               // the last external wrenches to the simulation
@@ -225,6 +227,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   std::mutex setupMutex_;                                         // one pose or mode change at a time
   std::atomic<Setup*> pendingSetup_{nullptr};                     // for the servo thread to take
   std::atomic<Setup*> appliedSetup_{nullptr};                     // the servo thread took this one
+  std::atomic<int> setupResult_{0};                               // and what became of it (SetupResult)
   bool builtForSimulation_ = true;                                // the mode and base the parts were built for
   Transform builtBase_ = Transform::unit();
   std::atomic<bool> usesHardware_{false};

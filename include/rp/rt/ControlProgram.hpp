@@ -137,6 +137,8 @@ class ControlProgram {
   void waitUntilStopped();
   /// Whether the loop thread runs.
   bool isRunning() const noexcept;
+  /// Whether the calling thread runs a control loop (any program's). Real-time safe: yes.
+  static bool isLoopThread() noexcept;
   /// Time of the current cycle on the program's clock [s]. Real-time safe: yes.
   double getTime() const noexcept;
   /// Number of cycles completed. Real-time safe: yes.

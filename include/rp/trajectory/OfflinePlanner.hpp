@@ -33,10 +33,16 @@ class OfflinePlanner {
   };
 
   /// Creates the planner.
-  /// @param[in] model  the arm's model (copied)
+  /// @param[in] model  the arm's model (copied, keeping its class: a Puma560Model keeps its
+  ///                   closed-form inverse kinematics, as the generator uses it on a real Puma)
   /// @param[in] start  joint positions the first motion starts from (dof x 1) [rad]
   /// @throws std::invalid_argument if `start` has the wrong size or is outside the limits
   OfflinePlanner(const ManipulatorModel& model, const JointVector& start);
+  /// Creates the planner on a shared model.
+  /// @param[in] model  the arm's model (not null)
+  /// @param[in] start  joint positions the first motion starts from (dof x 1) [rad]
+  /// @throws std::invalid_argument if `start` has the wrong size or is outside the limits
+  OfflinePlanner(std::shared_ptr<const ManipulatorModel> model, const JointVector& start);
   /// Drains what was queued and not sampled, then disconnects.
   ~OfflinePlanner();
   OfflinePlanner(const OfflinePlanner&) = delete;             ///< not copyable
@@ -55,7 +61,8 @@ class OfflinePlanner {
   /// the first sample at which the last motion has ended (at rest at its target); `duration` is
   /// that sample's time, within 1 / rate after the true end. Empty if nothing was queued.
   /// @param[in] rate         samples per second, > 0
-  /// @param[in] maxDuration  longest time sampled [s]; a longer plan throws std::length_error
+  /// @param[in] maxDuration  longest time sampled [s]; a longer plan, or more than 10^7 samples,
+  ///                         throws std::length_error
   /// @throws std::invalid_argument for a rate that is not positive
   Samples sample(double rate, double maxDuration = 3600);
 
