@@ -144,3 +144,51 @@ def test_step_without_the_simulated_clock_says_so():
     """)
     assert r.returncode == 0, r.stderr
     assert "RuntimeError: the platform runs on the real clock" in r.stdout
+
+
+def test_logging_to_csv_from_python_keeps_every_cycle(tmp_path):
+    log = tmp_path / "run.csv"
+    r = python("""
+        import sys, roboticplatform as rp
+        rp.init(["-simclock", "-nogui", "-log", sys.argv[1]])
+        puma = rp.Puma560("arm")
+        rp.pause()
+        rp.step(200)
+        puma.close()
+        print("closed")
+    """, str(log))
+    assert r.returncode == 0, r.stderr
+    assert "closed" in r.stdout
+    lines = log.read_text().splitlines()
+    header = lines[0].split(",")
+    assert any(h.startswith("arm.q") for h in header), header[:8]
+    assert len(lines) - 1 >= 200, "a row per cycle stepped, flushed when the arm closed"
+
+
+def test_the_scene_viewer_of_a_python_program_serves_its_page_and_ctrl_c_ends_it():
+    import signal
+    import urllib.request
+    script = textwrap.dedent("""
+        import time, roboticplatform as rp
+        rp.init(["-gui-port", "0"])
+        puma = rp.Puma560("arm")
+        while not rp.is_shutdown_requested():
+            time.sleep(0.05)
+    """)
+    child = subprocess.Popen([sys.executable, "-c", script], stderr=subprocess.PIPE, text=True)
+    try:
+        url = None
+        for _ in range(50):
+            line = child.stderr.readline()
+            m = re.search(r"Scene Viewer at (http://127\.0\.0\.1:\d+/\S*)", line)
+            if m:
+                url = m.group(1)
+                break
+        assert url, "no Scene Viewer address printed"
+        page = urllib.request.urlopen(url, timeout=30).read().decode()
+        assert "<html" in page.lower()
+        child.send_signal(signal.SIGINT)
+        assert child.wait(timeout=30) == 128 + signal.SIGINT, "Ctrl-C: a safe shutdown, status 130"
+    finally:
+        if child.poll() is None:
+            child.kill()
