@@ -292,6 +292,28 @@ void bindModels(py::module_& m) {
           },
           py::arg("q"), "fk of every row of an N x dof array: N x 4 x 4")
       .def(
+          "link_transforms_batch",
+          [](const PyModel& p, const py::handle& qs) {
+            const int n = p.dof();
+            auto q = toMatrix(qs, -1, n, "q");
+            const py::ssize_t rows = q.shape(0);
+            py::array_t<double> out({rows, py::ssize_t{n}, py::ssize_t{4}, py::ssize_t{4}});
+            double* o = out.mutable_data();
+            {
+              py::gil_scoped_release release;
+              ManipulatorData data(*p.model);
+              for (py::ssize_t r = 0; r < rows; ++r) {
+                forwardKinematics(*p.model, data, row(q, r, n));
+                for (int k = 0; k < n; ++k)
+                  for (int i = 0; i < 4; ++i)
+                    for (int j = 0; j < 4; ++j)
+                      o[((r * n + k) * 4 + i) * 4 + j] = data.linkTransforms[static_cast<std::size_t>(k)](i, j);
+              }
+            }
+            return out;
+          },
+          py::arg("q"), "link_transforms of every row of an N x dof array: N x dof x 4 x 4")
+      .def(
           "jacobian_batch",
           [](const PyModel& p, const py::handle& qs, const std::string& frame) {
             const int n = p.dof();
@@ -482,6 +504,44 @@ void bindModels(py::module_& m) {
             return py::make_tuple(statusName(status), fromVector(q));
           },
           py::arg("pose"), py::arg("current"), "the closed-form solution within the limits closest to current: (status, q)")
+      .def(
+          "ik_closest_batch",
+          [](const PyPuma& p, const py::handle& poses, const py::handle& currents) {
+            const py::array raw = py::array::ensure(poses);
+            if (!raw || (raw.dtype().kind() != 'f' && raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u'))
+              throw py::value_error("poses: expected real numbers (float64) of shape (N, 4, 4)");
+            const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(raw);
+            if (!a || a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
+              throw py::value_error("poses: expected an array of shape (N, 4, 4)");
+            const py::ssize_t rows = a.shape(0);
+            auto current = toMatrix(currents, -1, 6, "current");
+            if (current.shape(0) != rows) throw py::value_error("current: one row per pose");
+            std::vector<Transform> targets(static_cast<std::size_t>(rows));
+            for (py::ssize_t r = 0; r < rows; ++r) {
+              Transform t;
+              for (int i = 0; i < 4; ++i)
+                for (int j = 0; j < 4; ++j) t(i, j) = a.data()[(r * 4 + i) * 4 + j];
+              if (const std::string problem = rigidTransformError(t); !problem.empty())
+                throw py::value_error("poses[" + std::to_string(r) + "]: not a rigid transform: it " + problem);
+              targets[static_cast<std::size_t>(r)] = t;
+            }
+            py::array_t<double> out({rows, py::ssize_t{6}});
+            py::array_t<bool> solved(rows);
+            double* qo = out.mutable_data();
+            bool* so = solved.mutable_data();
+            {
+              py::gil_scoped_release release;
+              JointVector q(6);
+              for (py::ssize_t r = 0; r < rows; ++r) {
+                so[r] = p.puma().inverseKinematicsClosest(targets[static_cast<std::size_t>(r)], row(current, r, 6), q) ==
+                        IkStatus::Solved;
+                for (int i = 0; i < 6; ++i) qo[r * 6 + i] = q(i);
+              }
+            }
+            return py::make_tuple(solved, out);
+          },
+          py::arg("poses"), py::arg("current"),
+          "ik_closest of every pose of an N x 4 x 4 array, each from its row of current (N x 6): (solved, q)")
       .def(
           "branch_of", [](const PyPuma& p, const py::handle& q) { return std::string(p.puma().branchOf(p.q(q, "q")).branchName()); },
           py::arg("q"), "the branch of a joint vector, e.g. 'right-up-noflip'");

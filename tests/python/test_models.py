@@ -75,6 +75,8 @@ def test_batched_calls_equal_single_calls(make):
     fk, J, tau, M, acc = (model.fk_batch(Q), model.jacobian_batch(Q), model.rnea_batch(Q, QD, QDD), model.crba_batch(Q),
                           model.aba_batch(Q, QD, QDD))
     g = model.gravity_torque_batch(Q)
+    links = model.link_transforms_batch(Q)
+    assert links.shape == (50, model.dof, 4, 4)
     assert fk.shape == (50, 4, 4) and J.shape == (50, 6, model.dof) and M.shape == (50, model.dof, model.dof)
     for k in range(50):
         np.testing.assert_array_equal(fk[k], model.fk(Q[k]))
@@ -83,6 +85,7 @@ def test_batched_calls_equal_single_calls(make):
         np.testing.assert_array_equal(M[k], model.crba(Q[k]))
         np.testing.assert_array_equal(acc[k], model.aba(Q[k], QD[k], QDD[k]))
         np.testing.assert_array_equal(g[k], model.gravity_torque(Q[k]))
+        np.testing.assert_array_equal(links[k], model.link_transforms(Q[k]))
 
 
 def test_batched_calls_in_threads_give_the_same_results():
@@ -120,6 +123,15 @@ def test_puma_closed_form_ik_reproduces_random_poses_on_every_branch():
     far = np.eye(4)
     far[:3, 3] = [5, 0, 0]
     assert puma.ik_all(far) == []
+    # Batched: each pose from its own current joints, as the single call.
+    Q = random_q(puma, rng, 10)
+    poses = puma.fk_batch(Q)
+    solved, closest = puma.ik_closest_batch(poses, Q)
+    for k in range(10):
+        status, q = puma.ik_closest(poses[k], Q[k])
+        assert solved[k] == (status == "solved")
+        np.testing.assert_array_equal(closest[k], q)
+    assert solved.any()
 
 
 def test_numeric_ik_solves_reachable_wam_poses():
