@@ -73,7 +73,7 @@ document.getElementById('stop').onclick = () => send('stop');
 // to rest under the pointer instead of swinging past it.
 const STIFFNESS = 300; // [N/m]
 const DAMPING = 80; // [N s/m]
-const MAX_FORCE = 150; // [N]
+const MAX_FORCE = 60; // [N]: enough to move the arm by hand, not to drive it past its velocity limits
 let eeVelocity = new THREE.Vector3();
 let eeLast = null; // { p, t }
 let dragging = false;
