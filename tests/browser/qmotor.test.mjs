@@ -23,6 +23,9 @@ describe('QMotor window on work_cell -qmotor', () => {
     assert.deepEqual(await page.evaluate(() => window.rp.series), ['q[0]', 'q[1]', 'q[2]', 'q[3]', 'q[4]', 'q[5]']);
     const n0 = await page.evaluate(() => window.rp.samples);
     await waitInPage(page, (n) => window.rp.samples > n + 30, n0);
+    // The arm's first motion may start a while after the page opens (a slow sanitizer build):
+    // wait until the plot shows joint 1 moving.
+    await waitInPage(page, () => Math.max(...window.rp.data[1]) - Math.min(...window.rp.data[1]) > 1e-3);
     const got = await page.evaluate(() => ({ n: window.rp.samples, t: window.rp.data[0], q: window.rp.data[1] }));
     assert.ok(got.t[got.t.length - 1] > got.t[0], 'time does not advance');
     assert.ok(Math.max(...got.q) - Math.min(...got.q) > 1e-3, 'joint 1 does not move in the plot');

@@ -39,7 +39,7 @@ describe('rp-teachpendant', () => {
     await ctx.page.keyboard.down('Shift');
     await ctx.page.mouse.move(ee.x, ee.y);
     await ctx.page.mouse.down();
-    await ctx.page.mouse.move(ee.x + 40, ee.y + 20, { steps: 5 });
+    await ctx.page.mouse.move(ee.x + 25, ee.y + 12, { steps: 5 });
     await sleep(1500); // the spring-damper brings the end-effector under the pointer
     await ctx.page.mouse.up();
     await ctx.page.keyboard.up('Shift');

@@ -55,6 +55,7 @@ import numpy as np, roboticplatform as rp
 rp.init(["-simclock", "-nogui"])
 puma = rp.Puma560("arm")
 rp.pause()
+rp.step(1)  # a cycle already under way when the clock paused ends first
 tragen = rp.TrajectoryGenerator()
 puma.set_trajectory_generator(tragen)
 del tragen  # the arm keeps its generator alive
