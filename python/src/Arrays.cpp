@@ -79,6 +79,22 @@ Transform toTransform(const py::handle& value, const char* what) {
   return t;
 }
 
+std::vector<Transform> toTransforms(const py::handle& value, const char* what) {
+  const std::string name(what);
+  auto a = realArray(value, what, "(N, 4, 4)");
+  if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
+    throw py::value_error(name + ": expected an array of shape (N, 4, 4), got " + shapeOf(a));
+  std::vector<Transform> poses(static_cast<std::size_t>(a.shape(0)));
+  for (py::ssize_t r = 0; r < a.shape(0); ++r) {
+    Transform& t = poses[static_cast<std::size_t>(r)];
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) t(i, j) = a.data()[(r * 4 + i) * 4 + j];
+    if (const std::string problem = rigidTransformError(t); !problem.empty())
+      throw py::value_error(name + "[" + std::to_string(r) + "]: not a rigid transform: it " + problem);
+  }
+  return poses;
+}
+
 py::array_t<double> fromVector(const Eigen::Ref<const Eigen::VectorXd>& v) {
   py::array_t<double> a(v.size());
   for (Eigen::Index i = 0; i < v.size(); ++i) a.mutable_data()[i] = v(i);

@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 
 #include <string>
+#include <vector>
 
 #include "rp/math/Matrix.hpp"
 #include "rp/math/Transform.hpp"
@@ -26,6 +27,11 @@ py::array_t<double, py::array::c_style> toMatrix(const py::handle& value, int ro
 /// A 4 x 4 rigid transform.
 /// @throws py::value_error naming `what` if it is not 4 x 4, not finite or not rigid
 Transform toTransform(const py::handle& value, const char* what);
+
+/// An N x 4 x 4 array of rigid transforms.
+/// @throws py::value_error naming `what` (and the row) if it is not N x 4 x 4 real numbers or a
+///         row is not a rigid transform
+std::vector<Transform> toTransforms(const py::handle& value, const char* what);
 
 /// A vector as a new 1-D float64 array.
 py::array_t<double> fromVector(const Eigen::Ref<const Eigen::VectorXd>& v);

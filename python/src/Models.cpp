@@ -383,22 +383,8 @@ void bindModels(py::module_& m) {
           [](const PyModel& p, const py::handle& poses, const py::object& seeds, double positionTolerance,
              double orientationTolerance, int maxAttempts) {
             const int n = p.dof();
-            const py::array raw = py::array::ensure(poses);
-            if (!raw || (raw.dtype().kind() != 'f' && raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u'))
-              throw py::value_error("poses: expected real numbers (float64) of shape (N, 4, 4)");
-            const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(raw);
-            if (!a || a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
-              throw py::value_error("poses: expected an array of shape (N, 4, 4)");
-            const py::ssize_t rows = a.shape(0);
-            std::vector<Transform> targets(static_cast<std::size_t>(rows));
-            for (py::ssize_t r = 0; r < rows; ++r) {
-              Transform t;
-              for (int i = 0; i < 4; ++i)
-                for (int j = 0; j < 4; ++j) t(i, j) = a.data()[(r * 4 + i) * 4 + j];
-              if (const std::string problem = rigidTransformError(t); !problem.empty())
-                throw py::value_error("poses[" + std::to_string(r) + "]: not a rigid transform: it " + problem);
-              targets[static_cast<std::size_t>(r)] = t;
-            }
+            const std::vector<Transform> targets = toTransforms(poses, "poses");
+            const auto rows = static_cast<py::ssize_t>(targets.size());
             py::array_t<double, py::array::c_style> seed;
             if (!seeds.is_none()) {
               seed = toMatrix(seeds, -1, n, "seeds");
@@ -507,24 +493,10 @@ void bindModels(py::module_& m) {
       .def(
           "ik_closest_batch",
           [](const PyPuma& p, const py::handle& poses, const py::handle& currents) {
-            const py::array raw = py::array::ensure(poses);
-            if (!raw || (raw.dtype().kind() != 'f' && raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u'))
-              throw py::value_error("poses: expected real numbers (float64) of shape (N, 4, 4)");
-            const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(raw);
-            if (!a || a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
-              throw py::value_error("poses: expected an array of shape (N, 4, 4)");
-            const py::ssize_t rows = a.shape(0);
+            const std::vector<Transform> targets = toTransforms(poses, "poses");
+            const auto rows = static_cast<py::ssize_t>(targets.size());
             auto current = toMatrix(currents, -1, 6, "current");
             if (current.shape(0) != rows) throw py::value_error("current: one row per pose");
-            std::vector<Transform> targets(static_cast<std::size_t>(rows));
-            for (py::ssize_t r = 0; r < rows; ++r) {
-              Transform t;
-              for (int i = 0; i < 4; ++i)
-                for (int j = 0; j < 4; ++j) t(i, j) = a.data()[(r * 4 + i) * 4 + j];
-              if (const std::string problem = rigidTransformError(t); !problem.empty())
-                throw py::value_error("poses[" + std::to_string(r) + "]: not a rigid transform: it " + problem);
-              targets[static_cast<std::size_t>(r)] = t;
-            }
             py::array_t<double> out({rows, py::ssize_t{6}});
             py::array_t<bool> solved(rows);
             double* qo = out.mutable_data();
