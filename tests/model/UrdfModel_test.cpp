@@ -27,6 +27,7 @@
 #include "rp/model/PhysicalModel.hpp"
 #include "rp/model/Puma560Model.hpp"
 #include "rp/model/UrdfExport.hpp"
+#include "UrdfDom.hpp"
 #include "rp/model/UrdfModel.hpp"
 
 namespace rp {
@@ -34,21 +35,8 @@ namespace {
 
 const std::string kData = RP_TEST_DATA_DIR;
 
-Transform pose(const urdf::Pose& p) {
-  Transform t = Transform::unit();
-  t.topLeftCorner<3, 3>() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).toRotationMatrix();
-  t(0, 3) = p.position.x;
-  t(1, 3) = p.position.y;
-  t(2, 3) = p.position.z;
-  return t;
-}
-
-urdf::ModelInterfaceSharedPtr parse(const std::string& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return urdf::parseURDF(s.str());
-}
+using test::parse;
+using test::pose;
 
 std::vector<urdf::JointConstSharedPtr> chainTo(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip) {
   std::vector<urdf::JointConstSharedPtr> chain;
