@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/mman.h>
 #include <time.h>
 #include <unistd.h>
@@ -27,20 +28,16 @@ bool validName(const std::string& name) {
   });
 }
 
-// An existing segment whose server process is gone (killed) may be replaced.
+// An existing segment whose server is gone (killed, crashed) may be replaced. A running server
+// holds an exclusive flock on its segment for as long as it lives; the kernel drops that lock when
+// the process ends however it ends, so a lock we can take means nobody serves the segment. (The
+// pid stored in the segment is not enough: after a reboot or in a fresh container the same pid
+// may belong to another, living process.)
 bool staleSegment(const std::string& shmName) {
-  const int fd = ::shm_open(shmName.c_str(), O_RDONLY, 0);
+  const int fd = ::shm_open(shmName.c_str(), O_RDONLY | O_CLOEXEC, 0);
   if (fd < 0) return false;
-  bool stale = false;
-  void* p = ::mmap(nullptr, sizeof(internal::HwServerShm), PROT_READ, MAP_SHARED, fd, 0);
-  if (p != MAP_FAILED) {
-    const auto* shm = static_cast<const internal::HwServerShm*>(p);
-    const int pid = shm->serverPid.load();
-    stale = shm->magic != internal::kHwServerMagic || pid <= 0 || (::kill(pid, 0) != 0 && errno == ESRCH) ||
-            shm->state.load() == static_cast<std::int32_t>(internal::HwServerState::kStopped);
-    ::munmap(p, sizeof(internal::HwServerShm));
-  }
-  ::close(fd);
+  const bool stale = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+  ::close(fd);  // also drops the lock just taken
   return stale;
 }
 
@@ -68,13 +65,21 @@ void HwServer::start() {
   if (shm_ != nullptr) return;
   const std::string shmName = internal::hwServerShmName(name_);
   int fd = ::shm_open(shmName.c_str(), O_CREAT | O_EXCL | O_RDWR | O_CLOEXEC, 0600);
-  if (fd < 0 && errno == EEXIST && staleSegment(shmName)) {
+  int err = errno;
+  if (fd < 0 && err == EEXIST && staleSegment(shmName)) {
     ::shm_unlink(shmName.c_str());
     fd = ::shm_open(shmName.c_str(), O_CREAT | O_EXCL | O_RDWR | O_CLOEXEC, 0600);
+    err = errno;
   }
   if (fd < 0)
     throw IoException("HwServer '" + name_ + "': cannot create shared memory " + shmName + ": " +
-                      std::strerror(errno) + (errno == EEXIST ? " (another server of this name is running)" : ""));
+                      std::strerror(err) + (err == EEXIST ? " (another server of this name is running)" : ""));
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {  // held until stop() or the process ends
+    const int err = errno;
+    ::close(fd);
+    throw IoException("HwServer '" + name_ + "': cannot lock shared memory " + shmName + ": " + std::strerror(err) +
+                      " (another server of this name is starting)");
+  }
   if (::ftruncate(fd, sizeof(internal::HwServerShm)) != 0) {
     const int err = errno;
     ::close(fd);
@@ -82,11 +87,14 @@ void HwServer::start() {
     throw IoException("HwServer '" + name_ + "': cannot size shared memory: " + std::strerror(err));
   }
   void* p = ::mmap(nullptr, sizeof(internal::HwServerShm), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-  ::close(fd);
   if (p == MAP_FAILED) {
+    const int err = errno;
+    ::close(fd);
     ::shm_unlink(shmName.c_str());
+    errno = err;
     throw IoException("HwServer '" + name_ + "': cannot map shared memory: " + std::strerror(errno));
   }
+  lockFd_ = fd;
   shm_ = static_cast<internal::HwServerShm*>(p);  // zero-filled by ftruncate: every atomic starts at 0
   shm_->version = internal::kHwServerVersion;
   shm_->size = sizeof(internal::HwServerShm);
@@ -122,6 +130,8 @@ void HwServer::stop() {
   ::munmap(shm_, sizeof(internal::HwServerShm));
   shm_ = nullptr;
   ::shm_unlink(internal::hwServerShmName(name_).c_str());
+  ::close(lockFd_);  // unlinked first: a new server of this name creates a fresh segment
+  lockFd_ = -1;
 }
 
 std::uint64_t HwServer::cycles() const noexcept { return shm_ ? shm_->cycle.load() : finalCycles_; }

@@ -40,10 +40,20 @@ class ChildProcess {
       throw std::runtime_error("cannot start " + argv[0]);
     }
   }
+  // A child still running gets SIGTERM and 5 s to end cleanly (a hardware server removes its
+  // shared memory then), then SIGKILL.
   ~ChildProcess() {
     if (pid_ > 0 && !exited_) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
+      ::kill(pid_, SIGTERM);
+      bool ended = false;
+      for (int i = 0; i < 500 && !ended; ++i) {
+        ended = ::waitpid(pid_, nullptr, WNOHANG) == pid_;
+        if (!ended) ::usleep(10000);
+      }
+      if (!ended) {
+        ::kill(pid_, SIGKILL);
+        ::waitpid(pid_, nullptr, 0);
+      }
     }
     ::close(out_);
   }

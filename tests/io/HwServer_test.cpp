@@ -3,9 +3,11 @@
 #include "rp/io/HwServer.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -123,6 +125,39 @@ TEST(HwServer, RejectsBadNamesAndRates) {
   } catch (const IoException& e) {
     EXPECT_TRUE(contains(e.what(), "another server of this name is running")) << e.what();
   }
+}
+
+// A server that died leaves its segment behind, and the pid stored in it may by then belong to
+// another, living process (in a fresh container pids repeat from run to run). The segment is still
+// replaced: it is the server's lock that tells a living server, not its pid.
+TEST(HwServer, ASegmentLeftByADeadServerIsReplacedEvenIfItsPidLivesOn) {
+  const std::string name = uniqueName("pidreuse");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    SimulatedIoBoard board;
+    HwServer server(board, name, 100.0);
+    server.start();
+    // exec ends the server (its thread and its lock) but not the process: the pid lives on.
+    ::execl("/bin/sleep", "sleep", "30", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  bool replaced = false;
+  for (int i = 0; i < 1000; ++i) {  // bounded: 10 s
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::ifstream comm("/proc/" + std::to_string(child) + "/comm");
+    std::string what;
+    if (!(comm >> what) || what != "sleep") continue;
+    SimulatedIoBoard board;
+    HwServer server(board, name, 100.0);
+    EXPECT_NO_THROW(server.start()) << "the dead server's segment was not replaced";
+    HwServerIoBoard client(name);
+    replaced = client.waitForCycle(2000) == IoStatus::kOk;
+    break;
+  }
+  ::kill(child, SIGKILL);
+  ::waitpid(child, nullptr, 0);
+  EXPECT_TRUE(replaced);
 }
 
 TEST(RpHwServer, ServesASimulatedBoardAndDetectsItsDeath) {

@@ -105,6 +105,7 @@ class HwServer {
   double rateHz_;
   double watchdogMs_;
   internal::HwServerShm* shm_ = nullptr;
+  int lockFd_ = -1;  // the segment's descriptor, flock'ed while this server runs
   int counts_[5] = {0, 0, 0, 0, 0};
   bool lastDigitalOut_[64] = {};
   double lastAnalogOut_[64] = {};
