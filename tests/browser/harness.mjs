@@ -125,6 +125,18 @@ export function pixelsChanged(a, b) {
   return n;
 }
 
+// Waits (up to timeoutMs) until more than minPixels of the canvas differ from `before`, and returns
+// how many do: the page draws a change in its next animation frames, which a loaded machine (the
+// ASan build) may delay, and a small motion (a wrist joint) changes few pixels at first.
+export async function waitForPictureChange(page, before, minPixels = 50, timeoutMs = 10000) {
+  let changed = 0;
+  for (const end = Date.now() + timeoutMs; changed <= minPixels && Date.now() < end;) {
+    await sleep(200);
+    changed = pixelsChanged(before, await canvasStats(page));
+  }
+  return changed;
+}
+
 // A raw WebSocket upgrade request from Node (no browser: any Origin header we like).
 export function upgradeStatus(url, { origin, token } = {}) {
   const u = new URL(url);

@@ -5,7 +5,7 @@ import { describe, it } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import {
-  withProgram, openViewer, waitInPage, canvasStats, pixelsChanged, upgradeStatus, sleep,
+  withProgram, openViewer, waitInPage, canvasStats, waitForPictureChange, upgradeStatus, sleep,
 } from './harness.mjs';
 
 const TOKEN = 'browser-test-token-1234';
@@ -25,9 +25,8 @@ describe('Scene Viewer on work_cell', () => {
     const q0 = await ctx.page.evaluate(() => window.rp.frame.objects[0].values.slice(0, 6));
     // Wait until the arm has moved by 0.1 rad in some joint (it may be at one of its stops).
     await waitInPage(ctx.page, (q) => window.rp.frame.objects[0].values.slice(0, 6).some((x, i) => Math.abs(x - q[i]) > 0.1), q0);
-    await sleep(200);  // a few frames drawn
-    const b = await canvasStats(ctx.page);
-    assert.ok(pixelsChanged(a, b) > 50, `the picture did not change (${pixelsChanged(a, b)} pixels)`);
+    const changed = await waitForPictureChange(ctx.page, a);
+    assert.ok(changed > 50, `the picture did not change (${changed} pixels)`);
     if (shots) await ctx.page.screenshot({ path: join(shots, 'scene-viewer.png') });
   });
 

@@ -6,6 +6,9 @@ hwserver=$1 program=$2 work=$3
 name="svr-$$"
 mkdir -p "$work"
 printf '[puma]\nclass Puma560\nsimulationMode off\nhwserver %s\n' "$name" > "$work/rp.cfg"
+# Emptied here, not by the server's redirection below: that happens in the child, and the wait
+# loop could read the previous run's "serving" line first.
+: > "$work/hwserver.log"
 # -watchdog 5000: a servo loop stalled by a loaded test machine is not cut off by the server.
 "$hwserver" -name "$name" -rate 1000 -board puma560 -watchdog 5000 -duration 120 > "$work/hwserver.log" 2>&1 &
 server=$!
