@@ -275,6 +275,7 @@ void HwServer::cycle(bool writeAll) {
     if (s != IoStatus::kOk && status == IoStatus::kOk) status = s;
     return s == IoStatus::kOk;
   };
+  shm_->inputSeq.fetch_add(1, std::memory_order_acq_rel);  // odd: the inputs are being stored
   for (int i = 0; i < counts_[0] && status == IoStatus::kOk; ++i) {
     bool v = false;
     if (ok(board_.readDigitalInput(i, v))) shm_->digitalIn[i].store(v ? 1 : 0);
@@ -287,6 +288,10 @@ void HwServer::cycle(bool writeAll) {
     std::int64_t v = 0;
     if (ok(board_.readEncoder(i, v))) shm_->encoders[i].store(v);
   }
+  // Stamped when the reads have returned: a read held up (a slow board, the server descheduled)
+  // returns the inputs of when it returned, not of when it began.
+  shm_->inputTimeNs.store(internal::monotonicNs());
+  shm_->inputSeq.fetch_add(1, std::memory_order_release);
   if (status != IoStatus::kOk) {
     // Sequence lock: odd while the message is being written.
     shm_->messageSeq.fetch_add(1, std::memory_order_acq_rel);

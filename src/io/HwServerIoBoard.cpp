@@ -163,6 +163,11 @@ int HwServerIoBoard::numEncoders() const noexcept { return shm_->numEncoders; }
 
 std::uint64_t HwServerIoBoard::serverCycles() const noexcept { return shm_->cycle.load(); }
 
+std::int64_t HwServerIoBoard::inputSampleTime() const noexcept {
+  if ((shm_->inputSeq.load(std::memory_order_acquire) & 1u) != 0) return -1;
+  return shm_->inputTimeNs.load(std::memory_order_acquire);
+}
+
 IoStatus HwServerIoBoard::checkServer() noexcept {
   const std::int64_t now = internal::monotonicNs();
   internal::HwClientSlot& me = shm_->clients[slot_];

@@ -11,7 +11,7 @@
 namespace rp::internal {
 
 constexpr std::uint64_t kHwServerMagic = 0x52504857'53525631ULL;  // "RPHWSRV1"
-constexpr std::uint32_t kHwServerVersion = 2;
+constexpr std::uint32_t kHwServerVersion = 3;
 constexpr int kHwServerMaxLines = 64;    // per kind of line
 constexpr int kHwServerMaxClients = 16;  // attached HwServerIoBoard objects at a time
 
@@ -73,6 +73,10 @@ struct HwServerShm {
   std::atomic<std::int32_t> analogOutResult[kHwServerMaxLines];
   std::atomic<std::uint32_t> writeMessageSeq;  // the board's message for the last refused write (sequence lock)
   char writeMessage[256];
+  // The inputs of one cycle are one sample: inputSeq is odd while the server stores them, and
+  // inputTimeNs (CLOCK_MONOTONIC) says when the board's reads for them had returned.
+  std::atomic<std::uint32_t> inputSeq;
+  std::atomic<std::int64_t> inputTimeNs;
 };
 
 static_assert(std::atomic<double>::is_always_lock_free && std::atomic<std::int64_t>::is_always_lock_free,

@@ -152,6 +152,7 @@ void DefaultManipulator::applySetup(Setup& setup) noexcept {
   if (board_ != nullptr) {
     // The hardware takes over: the arm is where its encoders say.
     velocity_->reset();
+    lastSampleTime_ = 0;
     if (!readHardware(getPeriod())) return ioFailure("reading the encoders", 0);
     (void)velocity_->differentiate(q_);
     qd_.setZero();
@@ -525,10 +526,26 @@ void DefaultManipulator::declareSettings(SettingSchema& schema) {
 }
 
 bool DefaultManipulator::readHardware(double elapsed) {
-  for (int i = 0; i < q_.size(); ++i) {
-    std::int64_t counts = 0;
-    if (board_->readEncoder(i, counts) != IoStatus::kOk) return false;
-    q_(i) = static_cast<double>(counts) / countsPerRadian_;
+  // A board that samples its inputs on its own clock (the hardware server, once per server
+  // cycle) says when: all joints are read from one sample (a few bounded retries while the server
+  // stores a new one), and the velocity is the change between samples over the time between them.
+  // A server descheduled for a few cycles otherwise shows the joints standing still (velocity 0,
+  // and the servo control pushes) and then jumping (a spike, a false velocity fault).
+  std::int64_t sampled = -1;
+  for (int attempt = 0; attempt < 8 && sampled < 0; ++attempt) {
+    const std::int64_t before = board_->inputSampleTime();
+    for (int i = 0; i < q_.size(); ++i) {  // read even while a sample is stored: a failure shows
+      std::int64_t counts = 0;
+      if (board_->readEncoder(i, counts) != IoStatus::kOk) return false;
+      if (before >= 0) q_(i) = static_cast<double>(counts) / countsPerRadian_;
+    }
+    if (before >= 0 && board_->inputSampleTime() == before) sampled = before;
+  }
+  if (sampled < 0) return true;  // the server was storing a sample each time: none new this cycle
+  if (sampled > 0) {
+    if (sampled == lastSampleTime_) return true;  // no new sample: position and velocity as they were
+    if (lastSampleTime_ > 0) elapsed = static_cast<double>(sampled - lastSampleTime_) * 1e-9;
+    lastSampleTime_ = sampled;
   }
   // Over the time that really passed: after a stalled cycle the encoders moved for several
   // periods, which divided by one period would be a velocity spike (and a false velocity fault).
@@ -569,11 +586,12 @@ void DefaultManipulator::enterControl() {
   loopEnded_.store(false);
   // The rate is final now (rp.cfg's qmotorConfig may have set it after construction): the
   // velocity filter takes this period (the servo controls take it in activate()); a restarted
-  // loop starts the filter afresh from where the arm is.
+  // loop starts the filter afresh with its first reading (not with the joints read at
+  // construction: divided by one period, the motion since then would be a velocity spike).
   if (board_) {
     if (velocity_->getSamplePeriod() != getPeriod()) velocity_ = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
     velocity_->reset();
-    (void)velocity_->differentiate(q_);
+    lastSampleTime_ = 0;
   }
   power_ = powerRequested_.load();
   sim_->setBrakes(!power_);

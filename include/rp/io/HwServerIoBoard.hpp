@@ -108,6 +108,10 @@ class HwServerIoBoard : public IoBoard {
   /// The server's watchdog time [ms].
   /// Real-time safe: yes.
   double watchdogMs() const noexcept;
+  /// When the server last read the board's inputs (CLOCK_MONOTONIC [ns]); -1 while it stores a
+  /// new sample. See IoBoard::inputSampleTime().
+  /// Real-time safe: yes.
+  std::int64_t inputSampleTime() const noexcept override;
   /// Completed cycles of the server.
   /// Real-time safe: yes.
   std::uint64_t serverCycles() const noexcept;

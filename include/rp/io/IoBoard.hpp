@@ -94,6 +94,15 @@ class IoBoard {
     return IoStatus::kOk;
   }
 
+  /// When the inputs that the reads return were sampled, for a board that samples them on a clock
+  /// of its own (a hardware server reads its board once per server cycle): CLOCK_MONOTONIC [ns].
+  /// Two calls that return the same time bracket reads of one sample; a reader that differentiates
+  /// positions divides by the time between samples, and knows a repeated sample for one.
+  /// @return the sample time [ns]; 0 if the inputs are sampled when read (every board but
+  ///         `HwServerIoBoard`); -1 while a new sample is being stored (read again)
+  /// Real-time safe: yes.
+  virtual std::int64_t inputSampleTime() const noexcept { return 0; }
+
   /// Status of the last failed operation (`kOk` if none failed yet).
   /// Real-time safe: yes.
   IoStatus lastStatus() const noexcept { return error_.status(); }

@@ -261,6 +261,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   bool power_ = false;
   double restTime_ = 0, shutdownStart_ = 0;
   double lastCycleTime_ = -1;   // time of the previous cycle (-1 before the first)
+  std::int64_t lastSampleTime_ = 0;  // the board's time of the joints last read [ns] (0: none, or not known)
   double saturatedJoints_ = 0;  // log column `saturated`: joints at their torque limit this cycle
   double missedCycles_ = 0;     // log column `missed`: deadlines skipped so far
   std::atomic<std::uint64_t> saturatedCycles_{0};
