@@ -380,6 +380,10 @@ std::string SceneState::buildFrame() {
           } else if (name.rfind("link", 0) == 0) {
             int k = std::atoi(name.c_str() + 4);
             if (k >= 1 && k <= model.getNumberOfJoints()) poses[f] = e.data->linkTransforms[static_cast<std::size_t>(k - 1)];
+          } else if (name.rfind("chain", 0) == 0 && e.data->chain) {
+            // A link of a chain with mimic joints (those the mimic joints move included).
+            int k = std::atoi(name.c_str() + 5);
+            if (k >= 1 && k <= e.data->chain->n) poses[f] = e.data->chain->linkTransforms[static_cast<std::size_t>(k - 1)];
           }
         }
       }

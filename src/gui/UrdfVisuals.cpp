@@ -175,18 +175,22 @@ std::vector<UrdfVisual> readUrdfVisuals(const std::string& urdfFile, const UrdfV
   const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text.str());
   if (!robot || !robot->getRoot()) throw UrdfError(urdfFile + ": not a valid URDF file");
 
-  // The movable joints of the chain root -> tip, in order: the model's own joints (loadUrdf()
-  // chose the tip and kept the URDF's joint names).
+  // The movable joints of the chain root -> tip, in order: the model's own joints and the mimic
+  // joints that follow them (loadUrdf() chose the tip and kept the URDF's joint names).
+  const ManipulatorModel& chainModel = model->getChain();
   std::vector<std::string> chain;
-  for (int i = 0; i < model->getNumberOfJoints(); ++i) chain.push_back(model->getJointName(i));
-  const int n = model->getNumberOfJoints();
+  for (int i = 0; i < chainModel.getNumberOfJoints(); ++i) chain.push_back(chainModel.getJointName(i));
+  const int n = chainModel.getNumberOfJoints();
+  // The frames shapes are attached to: the model's link frames `linkK`, or with mimic joints the
+  // chain's `chainK` (a link a mimic joint moves has no model link frame).
+  const std::string framePrefix = model->hasMimicJoints() ? "chain" : "link";
 
-  // Model link frames at q = 0 in the URDF root frame (the model's base is the root frame; joint
+  // Chain link frames at q = 0 in the URDF root frame (the model's base is the root frame; joint
   // values keep the URDF's zero, so URDF link poses at q = 0 compare directly).
-  ManipulatorData data(*model);
-  forwardKinematics(*model, data, JointVector::Zero(n));
+  ManipulatorData data(chainModel);
+  forwardKinematics(chainModel, data, JointVector::Zero(n));
   auto frameAtZero = [&](int k) -> Transform {
-    return k == 0 ? model->getBaseTransform() : Transform(data.linkTransforms[static_cast<std::size_t>(k - 1)]);
+    return k == 0 ? chainModel.getBaseTransform() : Transform(data.linkTransforms[static_cast<std::size_t>(k - 1)]);
   };
 
   std::vector<UrdfVisual> visuals;
@@ -194,7 +198,7 @@ std::vector<UrdfVisual> readUrdfVisuals(const std::string& urdfFile, const UrdfV
   std::function<void(const urdf::LinkConstSharedPtr&, const Transform&, int)> visit =
       [&](const urdf::LinkConstSharedPtr& link, const Transform& pose, int k) {
         const Transform inFrame = Transform(rigidInverse(frameAtZero(k)) * pose);
-        const std::string frame = k == 0 ? "base" : "link" + std::to_string(k);
+        const std::string frame = k == 0 ? "base" : framePrefix + std::to_string(k);
         std::vector<Shape> collision;  // the link's collision geometry, the stand-in for a mesh not drawn
         for (const urdf::CollisionSharedPtr& c : link->collision_array) {
           if (!c || !c->geometry) continue;
