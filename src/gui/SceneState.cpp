@@ -259,6 +259,9 @@ json SceneState::describe(Entry& e) {
     const ManipulatorModel& model = e.manipulator->getModel();
     if (!e.data) e.data = std::make_unique<ManipulatorData>(model);
     j["joints"] = model.getNumberOfJoints();
+    json names = json::array();  // a URDF arm's own joint names; joint1, joint2, ... otherwise
+    for (int i = 0; i < model.getNumberOfJoints(); ++i) names.push_back(model.getJointName(i));
+    j["jointNames"] = names;
     j["qmin"] = vectorJson(model.getPositionMin());
     j["qmax"] = vectorJson(model.getPositionMax());
     j["vmax"] = vectorJson(model.getVelocityLimit());
