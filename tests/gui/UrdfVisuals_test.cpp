@@ -183,6 +183,52 @@ TEST(UrdfVisuals, LinksOfMimicJointsMoveWithTheirMaster) {
   std::filesystem::remove(file);
 }
 
+// Issue 20: links moved by joints off the chain (two fingers, the second a mimic) are drawn, on
+// the chain link they hang on, where loadUrdf() lumps them (and says so in a note): at the
+// fingers' lower limit 0.01 m (zero is outside it), the mimic finger at -0.5 * master + 0.05
+// along its own axis. They used to be left out.
+TEST(UrdfVisuals, MovingLinksOffTheChainAreDrawnWhereTheyAreLumped) {
+  const std::string file = (std::filesystem::temp_directory_path() / "rp_urdf_visuals_fingers.urdf").string();
+  const std::string box = "<visual><geometry><box size=\"0.02 0.02 0.06\"/></geometry></visual>";
+  const std::string inertial = "<inertial><mass value=\"0.1\"/><inertia ixx=\"1e-4\" ixy=\"0\" ixz=\"0\" iyy=\"1e-4\" iyz=\"0\" izz=\"1e-4\"/></inertial>";
+  const std::string limit = "<limit lower=\"0.01\" upper=\"0.04\" effort=\"10\" velocity=\"0.1\"/>";
+  std::ofstream(file) << "<robot name=\"fingers\"><link name=\"base\"/><link name=\"upper\">" << inertial
+                      << "</link><link name=\"hand\">" << box << "</link><link name=\"left_finger\">" << box << inertial
+                      << "</link><link name=\"right_finger\">" << box << inertial
+                      << "</link><joint name=\"shoulder\" type=\"revolute\"><parent link=\"base\"/><child link=\"upper\"/>"
+                         "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>"
+                         "<joint name=\"mount\" type=\"fixed\"><parent link=\"upper\"/><child link=\"hand\"/>"
+                         "<origin xyz=\"0.3 0 0\" rpy=\"0 1.5707963267948966 0\"/></joint>"
+                         "<joint name=\"finger_left\" type=\"prismatic\"><parent link=\"hand\"/><child link=\"left_finger\"/>"
+                         "<origin xyz=\"0 0 0.05\"/><axis xyz=\"0 1 0\"/>" << limit << "</joint>"
+                      << "<joint name=\"finger_right\" type=\"prismatic\"><parent link=\"hand\"/><child link=\"right_finger\"/>"
+                         "<origin xyz=\"0 0 0.05\"/><axis xyz=\"0 -1 0\"/>" << limit
+                      << "<mimic joint=\"finger_left\" multiplier=\"-0.5\" offset=\"0.05\"/></joint></robot>";
+  std::vector<std::string> notes;
+  rp::UrdfOptions modelOptions;
+  modelOptions.notes = &notes;
+  ASSERT_EQ(rp::loadUrdf(file, modelOptions)->getNumberOfJoints(), 1);  // the fingers are lumped...
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("links 'left_finger', 'right_finger' move off the chain: their mass is lumped into 'upper'"),
+            std::string::npos) << notes[0];  // ... and the loader says so
+  const rp::Transform hand = rp::Transform(rp::translation(0.3, 0, 0) * rotY(1.5707963267948966));
+  {
+    const double left = 0.01;
+    const auto visuals = rp::readUrdfVisuals(file, rp::UrdfVisualOptions());
+    ASSERT_EQ(visuals.size(), 3u);
+    const double right = -0.5 * left + 0.05;
+    const rp::Transform expected[3] = {hand, rp::Transform(hand * rp::translation(0, left, 0.05)),
+                                       rp::Transform(hand * rp::translation(0, -right, 0.05))};
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ(visuals[i].shape.frame, "link1");
+      EXPECT_LT((visuals[i].shape.pose - expected[i]).cwiseAbs().maxCoeff(), 1e-12) << visuals[i].link << " at " << left;
+    }
+    EXPECT_EQ(visuals[1].link, "left_finger");
+    EXPECT_EQ(visuals[2].link, "right_finger");
+  }
+  std::filesystem::remove(file);
+}
+
 // The mesh arm of the browser test, in its package folder rp_mesh_arm (package:// URIs).
 const std::string kPackages = std::string(RP_TEST_DATA_DIR) + "/packages";
 const std::string kMeshArm = kPackages + "/rp_mesh_arm/urdf/mesh_arm.urdf";
