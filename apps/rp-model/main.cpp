@@ -69,6 +69,11 @@ JointVector jointsOf(const ManipulatorModel& model, const std::map<std::string, 
       if (eq == std::string::npos) throw UsageError(name + ": '" + item + "' is not a name=value pair (give all values by name or none)");
       const std::string joint = item.substr(0, eq);
       const int i = model.findJoint(joint);
+      if (const int k = model.getChain().findJoint(joint); i < 0 && k >= 0 && model.hasMimicJoints()) {
+        const JointCoupling& c = model.getCoupling()[static_cast<std::size_t>(k)];
+        throw UsageError(name + ": joint '" + joint + "' is a mimic joint: it follows '" + model.getJointName(c.joint) +
+                         "'; give that joint's value");
+      }
       if (i < 0) {
         std::string names;
         for (int k = 0; k < n; ++k) {
@@ -228,6 +233,24 @@ int run(int argc, char** argv) {
   }
   out["joints"] = joints;
   out["links"] = links;
+  if (model->hasMimicJoints()) {
+    // The mimic joints on the chain: not joints of the model, moved with the joint they follow
+    // (and where --q was given, their value there).
+    JointVector chainQ;
+    const bool atQ = opts.count("--q") > 0 && command != "ik";
+    if (atQ) model->toChain(jointsOf(*model, opts, "--q", true), chainQ);
+    json mimics = json::array();
+    const ManipulatorModel& chain = model->getChain();
+    for (int k = 0; k < chain.getNumberOfJoints(); ++k) {
+      const JointCoupling& c = model->getCoupling()[static_cast<std::size_t>(k)];
+      if (!c.mimic) continue;
+      json m = {{"joint", chain.getJointName(k)}, {"link", chain.getLinkName(k)}, {"follows", model->getJointName(c.joint)},
+                {"multiplier", c.multiplier}, {"offset", c.offset}};
+      if (atQ) m["position"] = chainQ(k);
+      mimics.push_back(m);
+    }
+    out["mimic"] = mimics;
+  }
   std::cout << out.dump() << std::endl;
   return 0;
 }

@@ -259,6 +259,9 @@ json SceneState::describe(Entry& e) {
     const ManipulatorModel& model = e.manipulator->getModel();
     if (!e.data) e.data = std::make_unique<ManipulatorData>(model);
     j["joints"] = model.getNumberOfJoints();
+    json names = json::array();  // a URDF arm's own joint names; joint1, joint2, ... otherwise
+    for (int i = 0; i < model.getNumberOfJoints(); ++i) names.push_back(model.getJointName(i));
+    j["jointNames"] = names;
     j["qmin"] = vectorJson(model.getPositionMin());
     j["qmax"] = vectorJson(model.getPositionMax());
     j["vmax"] = vectorJson(model.getVelocityLimit());
@@ -380,6 +383,10 @@ std::string SceneState::buildFrame() {
           } else if (name.rfind("link", 0) == 0) {
             int k = std::atoi(name.c_str() + 4);
             if (k >= 1 && k <= model.getNumberOfJoints()) poses[f] = e.data->linkTransforms[static_cast<std::size_t>(k - 1)];
+          } else if (name.rfind("chain", 0) == 0 && e.data->chain) {
+            // A link of a chain with mimic joints (those the mimic joints move included).
+            int k = std::atoi(name.c_str() + 5);
+            if (k >= 1 && k <= e.data->chain->n) poses[f] = e.data->chain->linkTransforms[static_cast<std::size_t>(k - 1)];
           }
         }
       }

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <functional>
@@ -175,18 +176,45 @@ std::vector<UrdfVisual> readUrdfVisuals(const std::string& urdfFile, const UrdfV
   const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text.str());
   if (!robot || !robot->getRoot()) throw UrdfError(urdfFile + ": not a valid URDF file");
 
-  // The movable joints of the chain root -> tip, in order: the model's own joints (loadUrdf()
-  // chose the tip and kept the URDF's joint names).
+  // The movable joints of the chain root -> tip, in order: the model's own joints and the mimic
+  // joints that follow them (loadUrdf() chose the tip and kept the URDF's joint names).
+  const ManipulatorModel& chainModel = model->getChain();
   std::vector<std::string> chain;
-  for (int i = 0; i < model->getNumberOfJoints(); ++i) chain.push_back(model->getJointName(i));
-  const int n = model->getNumberOfJoints();
+  for (int i = 0; i < chainModel.getNumberOfJoints(); ++i) chain.push_back(chainModel.getJointName(i));
+  const int n = chainModel.getNumberOfJoints();
+  // The frames shapes are attached to: the model's link frames `linkK`, or with mimic joints the
+  // chain's `chainK` (a link a mimic joint moves has no model link frame).
+  const std::string framePrefix = model->hasMimicJoints() ? "chain" : "link";
 
-  // Model link frames at q = 0 in the URDF root frame (the model's base is the root frame; joint
+  // Chain link frames at q = 0 in the URDF root frame (the model's base is the root frame; joint
   // values keep the URDF's zero, so URDF link poses at q = 0 compare directly).
-  ManipulatorData data(*model);
-  forwardKinematics(*model, data, JointVector::Zero(n));
+  ManipulatorData data(chainModel);
+  forwardKinematics(chainModel, data, JointVector::Zero(n));
   auto frameAtZero = [&](int k) -> Transform {
-    return k == 0 ? model->getBaseTransform() : Transform(data.linkTransforms[static_cast<std::size_t>(k - 1)]);
+    return k == 0 ? chainModel.getBaseTransform() : Transform(data.linkTransforms[static_cast<std::size_t>(k - 1)]);
+  };
+
+  // Where a moving joint off the chain (a finger, a jaw) stands: where loadUrdf() lumps its links
+  // by default (a mimic joint at its master's value times the multiplier plus the offset; zero
+  // within the limits otherwise).
+  auto offChainMotion = [&](const urdf::Joint& joint) {
+    const urdf::Joint* j = &joint;
+    double multiplier = 1, offset = 0, v = 0;
+    for (std::size_t depth = 0; depth <= robot->joints_.size() && j; ++depth) {
+      if (!j->mimic) {
+        if (j->limits && j->type != urdf::Joint::CONTINUOUS) v = std::clamp(0.0, j->limits->lower, j->limits->upper);
+        break;
+      }
+      offset += multiplier * j->mimic->offset;
+      multiplier *= j->mimic->multiplier;
+      j = robot->getJoint(j->mimic->joint_name).get();
+    }
+    v = multiplier * v + offset;
+    const Eigen::Vector3d axis = Eigen::Vector3d(joint.axis.x, joint.axis.y, joint.axis.z).normalized();
+    Transform motion = Transform::unit();
+    if (joint.type == urdf::Joint::PRISMATIC) motion.topRightCorner<3, 1>() = v * axis;
+    else motion.topLeftCorner<3, 3>() = Eigen::AngleAxisd(v, axis).toRotationMatrix();
+    return motion;
   };
 
   std::vector<UrdfVisual> visuals;
@@ -194,7 +222,7 @@ std::vector<UrdfVisual> readUrdfVisuals(const std::string& urdfFile, const UrdfV
   std::function<void(const urdf::LinkConstSharedPtr&, const Transform&, int)> visit =
       [&](const urdf::LinkConstSharedPtr& link, const Transform& pose, int k) {
         const Transform inFrame = Transform(rigidInverse(frameAtZero(k)) * pose);
-        const std::string frame = k == 0 ? "base" : "link" + std::to_string(k);
+        const std::string frame = k == 0 ? "base" : framePrefix + std::to_string(k);
         std::vector<Shape> collision;  // the link's collision geometry, the stand-in for a mesh not drawn
         for (const urdf::CollisionSharedPtr& c : link->collision_array) {
           if (!c || !c->geometry) continue;
@@ -237,14 +265,19 @@ std::vector<UrdfVisual> readUrdfVisuals(const std::string& urdfFile, const UrdfV
           const urdf::LinkConstSharedPtr child = robot->getLink(j->child_link_name);
           if (!child) continue;
           int childK = k;
+          Transform motion = Transform::unit();
           if (isMovable(j)) {
-            // Only the chain's next joint moves a frame we have; other moving branches are left out.
-            if (k >= n || chain[static_cast<std::size_t>(k)] != j->name) continue;
-            childK = k + 1;
+            if (k < n && chain[static_cast<std::size_t>(k)] == j->name) {
+              childK = k + 1;  // the chain's next joint moves the next frame
+            } else {
+              // A moving link off the chain (a finger, a jaw) is drawn on the link it hangs on,
+              // where its mass is lumped.
+              motion = offChainMotion(*j);
+            }
           } else if (j->type != urdf::Joint::FIXED) {
             continue;  // floating or planar: not part of the arm
           }
-          visit(child, Transform(pose * poseOf(j->parent_to_joint_origin_transform)), childK);
+          visit(child, Transform(pose * poseOf(j->parent_to_joint_origin_transform) * motion), childK);
         }
       };
   visit(robot->getRoot(), Transform::unit(), 0);

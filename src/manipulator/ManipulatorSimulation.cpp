@@ -26,6 +26,11 @@ class PlantModel : public ManipulatorModel {
                          nominal.getGravity(), nominal.getConvention()) {
     setHomePosition(nominal.getHomePosition());
   }
+  // With mimic joints: `chain` coupled as the nominal model's chain is.
+  PlantModel(const ManipulatorModel& nominal, std::shared_ptr<const ManipulatorModel> chain)
+      : ManipulatorModel(std::move(chain), nominal.getCoupling()) {
+    setHomePosition(nominal.getHomePosition());
+  }
 };
 
 // `v` with n entries (an empty one: all `fallback`), each checked.
@@ -48,9 +53,13 @@ std::unique_ptr<const ManipulatorModel> buildPlant(const ManipulatorModel& nomin
   const JointVector friction = perJoint(d.frictionScale, n, 1.0, true, "friction scale");
   if (!std::isfinite(d.payload) || d.payload < 0)
     throw std::invalid_argument("ManipulatorSimulation: the payload must be finite and not negative");
+  // The deviations act on every link of the chain (with mimic joints: a mimic joint's link takes
+  // the values of the joint it follows).
+  const ManipulatorModel& chain = nominal.getChain();
   std::vector<LinkParameters> links;
-  for (int i = 0; i < n; ++i) {
-    LinkParameters l = nominal.getLink(i);
+  for (int k = 0; k < chain.getNumberOfJoints(); ++k) {
+    const int i = nominal.hasMimicJoints() ? nominal.getCoupling()[static_cast<std::size_t>(k)].joint : k;
+    LinkParameters l = chain.getLink(k);
     l.mass *= mass(i);
     l.inertia = Matrix<3, 3>(Eigen::Matrix3d(l.inertia) * inertia(i));
     const double f = d.friction ? friction(i) : 0.0;
@@ -75,6 +84,10 @@ std::unique_ptr<const ManipulatorModel> buildPlant(const ManipulatorModel& nomin
     l.com = Vector<3>(cNew);
     l.mass = m;
   }
+  if (nominal.hasMimicJoints())
+    return std::make_unique<PlantModel>(
+        nominal, std::make_shared<const ManipulatorModel>(chain.getName(), std::move(links), chain.getBaseTransform(),
+                                                          chain.getToolTransform(), chain.getGravity(), chain.getConvention()));
   return std::make_unique<PlantModel>(nominal, std::move(links));
 }
 

@@ -39,10 +39,13 @@ std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, const std::st
   std::unique_ptr<ManipulatorModel> m = loadUrdf(file, options);
   for (const std::string& note : notes) std::cerr << "rp: UrdfManipulator '" << name << "': " << note << std::endl;
   // Place the arm where the object stands: the object's pose times the URDF's own base frame.
+  const ManipulatorModel& chain = m->getChain();  // with mimic joints: the whole chain, coupled again below
   std::vector<LinkParameters> links;
-  for (int i = 0; i < m->getNumberOfJoints(); ++i) links.push_back(m->getLink(i));
-  return std::make_unique<ManipulatorModel>(m->getName(), links, Transform(base * m->getBaseTransform()),
-                                            m->getToolTransform(), m->getGravity(), m->getConvention());
+  for (int i = 0; i < chain.getNumberOfJoints(); ++i) links.push_back(chain.getLink(i));
+  auto placed = std::make_unique<ManipulatorModel>(chain.getName(), links, Transform(base * chain.getBaseTransform()),
+                                                   chain.getToolTransform(), chain.getGravity(), chain.getConvention());
+  if (!m->hasMimicJoints()) return placed;
+  return std::make_unique<ManipulatorModel>(std::shared_ptr<const ManipulatorModel>(std::move(placed)), m->getCoupling());
 }
 }  // namespace
 

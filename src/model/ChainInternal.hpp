@@ -44,6 +44,23 @@ inline const Transform& axisFrame(const ManipulatorModel& model, const Manipulat
   return j == 0 ? model.getBaseTransform() : data.linkTransforms[static_cast<std::size_t>(j - 1)];
 }
 
+// With mimic joints: the model's link frames and end-effector from the chain's last forward
+// kinematics (link frame i is that of joint i's chain joint).
+inline void framesFromChain(const ManipulatorModel& model, ManipulatorData& data) {
+  for (int i = 0; i < data.n; ++i)
+    data.linkTransforms[static_cast<std::size_t>(i)] = data.chain->linkTransforms[static_cast<std::size_t>(model.getChainIndex(i))];
+  data.endEffector = data.chain->endEffector;
+}
+
+// With mimic joints: tau = S^T chainTau (each chain joint's torque times its multiplier on the
+// joint that moves it).
+template <typename Out>
+inline void torqueFromChain(const ManipulatorModel& model, const JointVector& chainTau, Out& tau) {
+  for (int i = 0; i < model.getNumberOfJoints(); ++i) tau(i) = 0;
+  const std::vector<JointCoupling>& coupling = model.getCoupling();
+  for (std::size_t k = 0; k < coupling.size(); ++k) tau(coupling[k].joint) += coupling[k].multiplier * chainTau(static_cast<int>(k));
+}
+
 // The base-frame Jacobian into data.jacobian from the link frames of the last forward kinematics.
 void jacobianFromKinematics(const ManipulatorModel& model, ManipulatorData& data);
 

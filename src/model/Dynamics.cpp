@@ -120,6 +120,16 @@ void rnea(const ManipulatorModel& model, ManipulatorData& data, const JointVecto
 
 const JointVector& inverseDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                                    const JointVector& qd, const JointVector& qdd, const DynamicsOptions& options) {
+  if (model.hasMimicJoints()) {  // S^T tau_chain(S q + o, S qd, S qdd)
+    ManipulatorData& c = *data.chain;
+    model.toChain(q, data.chainQ);
+    model.toChain(qd, data.chainQd, false);
+    model.toChain(qdd, data.chainQdd, false);
+    rnea(model.getChain(), c, data.chainQ, data.chainQd, data.chainQdd, options.gravity, options.motorInertia, options.friction,
+         &options.tipWrench, c.tau);
+    internal::torqueFromChain(model, c.tau, data.tau);
+    return data.tau;
+  }
   rnea(model, data, q, qd, qdd, options.gravity, options.motorInertia, options.friction, &options.tipWrench, data.tau);
   return data.tau;
 }
@@ -161,6 +171,11 @@ namespace {
 
 void gravityTorque(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q, JointVector& tau) {
   forwardKinematics(model, data, q);
+  if (model.hasMimicJoints()) {  // S^T g_chain
+    gravityFromKinematics(model.getChain(), *data.chain, data.chainTau);
+    internal::torqueFromChain(model, data.chainTau, tau);
+    return;
+  }
   gravityFromKinematics(model, data, tau);
 }
 
@@ -172,6 +187,14 @@ void frictionTorque(const ManipulatorModel& model, const JointVector& qd, JointV
 
 void coriolisTorque(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q, const JointVector& qd,
                     JointVector& tau) {
+  if (model.hasMimicJoints()) {
+    ManipulatorData& c = *data.chain;
+    model.toChain(q, data.chainQ);
+    model.toChain(qd, data.chainQd, false);
+    rnea(model.getChain(), c, data.chainQ, data.chainQd, c.zero, false, false, false, nullptr, data.chainTau);
+    internal::torqueFromChain(model, data.chainTau, tau);
+    return;
+  }
   rnea(model, data, q, qd, data.zero, false, false, false, nullptr, tau);
 }
 
@@ -328,8 +351,59 @@ void ldlSolveInPlace(ManipulatorData& data, JointVector& x) {
 
 }  // namespace
 
+namespace {
+
+// With mimic joints: data.massMatrix = S^T M_chain S from the chain data's mass matrix.
+void massFromChain(const ManipulatorModel& model, ManipulatorData& data) {
+  const JointMatrix& Mc = data.chain->massMatrix;
+  const std::vector<JointCoupling>& coupling = model.getCoupling();
+  data.massMatrix.setZero();
+  for (std::size_t a = 0; a < coupling.size(); ++a)
+    for (std::size_t b = 0; b < coupling.size(); ++b)
+      data.massMatrix(coupling[a].joint, coupling[b].joint) +=
+          coupling[a].multiplier * coupling[b].multiplier * Mc(static_cast<int>(a), static_cast<int>(b));
+}
+
+// forwardDynamics() with mimic joints: (S^T M S) qdd = tau - S^T h, with M and h = g + C qd [+ tip
+// wrench] [+ friction] of the chain at S q + o and S qd, summed in forwardDynamics()'s order (so
+// that gravityTorque() at rest again gives exactly zero accelerations).
+const JointVector& coupledForwardDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
+                                          const JointVector& qd, const JointVector& tau, const DynamicsOptions& options) {
+  const ManipulatorModel& chain = model.getChain();
+  ManipulatorData& c = *data.chain;
+  forwardKinematics(model, data, q);  // the chain's, at data.chainQ
+  model.toChain(qd, data.chainQd, false);
+  if (options.gravity) {
+    gravityFromKinematics(chain, c, c.bias);
+  } else {
+    c.bias.setZero();
+  }
+  worldLinkInertias(chain, c);
+  velocityProductTorques(chain, c, data.chainQd, options.tipWrench, c.scratchTau);
+  for (int k = 0; k < c.n; ++k) {
+    double h = c.bias(k) + c.scratchTau(k);
+    if (options.friction) h += jointFriction(chain.getLink(k), data.chainQd(k));
+    c.bias(k) = h;
+  }
+  compositeRigidBody(chain, c, options.motorInertia);
+  massFromChain(model, data);
+  internal::torqueFromChain(model, c.bias, data.bias);
+  for (int i = 0; i < data.n; ++i) data.qdd(i) = tau(i) - data.bias(i);
+  ldlSolveInPlace(data, data.qdd);
+  return data.qdd;
+}
+
+}  // namespace
+
 const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                               bool motorInertia) {
+  if (model.hasMimicJoints()) {
+    model.toChain(q, data.chainQ);
+    massMatrix(model.getChain(), *data.chain, data.chainQ, motorInertia);
+    internal::framesFromChain(model, data);
+    massFromChain(model, data);
+    return data.massMatrix;
+  }
   forwardKinematics(model, data, q);
   worldLinkInertias(model, data);
   compositeRigidBody(model, data, motorInertia);
@@ -338,6 +412,7 @@ const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& da
 
 const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                                    const JointVector& qd, const JointVector& tau, const DynamicsOptions& options) {
+  if (model.hasMimicJoints()) return coupledForwardDynamics(model, data, q, qd, tau, options);
   // h = g(q) + C(q, qd) qd [+ tip wrench] [+ friction], summed in that order.
   forwardKinematics(model, data, q);
   if (options.gravity) {
@@ -361,6 +436,8 @@ const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorDat
 const JointVector& forwardDynamicsArticulatedBody(const ManipulatorModel& model, ManipulatorData& data,
                                                   const JointVector& q, const JointVector& qd, const JointVector& tau,
                                                   const DynamicsOptions& options) {
+  // The articulated-body recursion has no place for a joint that follows another: S^T M S instead.
+  if (model.hasMimicJoints()) return coupledForwardDynamics(model, data, q, qd, tau, options);
   // Featherstone's articulated-body algorithm with every spatial vector (angular; linear) in world
   // coordinates at the world origin: no coordinate transforms between links, so articulated
   // inertias and bias forces add directly into the parent and accelerations carry over as they are.

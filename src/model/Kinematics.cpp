@@ -9,6 +9,12 @@ namespace rp {
 
 
 const Transform& forwardKinematics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q) {
+  if (model.hasMimicJoints()) {  // the full chain at q_chain = S q + o
+    model.toChain(q, data.chainQ);
+    forwardKinematics(model.getChain(), *data.chain, data.chainQ);
+    internal::framesFromChain(model, data);
+    return data.endEffector;
+  }
   // T_i = T_{i-1} A_i on the affine part only (the last row of a transform is constant).
   const Transform* previous = &model.getBaseTransform();
   for (int i = 0; i < data.n; ++i) {
@@ -30,6 +36,14 @@ const Transform& forwardKinematics(const ManipulatorModel& model, ManipulatorDat
 namespace internal {
 
 void jacobianFromKinematics(const ManipulatorModel& model, ManipulatorData& data) {
+  if (model.hasMimicJoints()) {  // J S: a mimic joint's column, times its multiplier, on its master's
+    jacobianFromKinematics(model.getChain(), *data.chain);
+    data.jacobian.setZero();
+    const std::vector<JointCoupling>& coupling = model.getCoupling();
+    for (std::size_t k = 0; k < coupling.size(); ++k)
+      data.jacobian.col(coupling[k].joint) += coupling[k].multiplier * data.chain->jacobian.col(static_cast<int>(k));
+    return;
+  }
   const Eigen::Vector3d pe = data.endEffector.topRightCorner<3, 1>();
   for (int i = 0; i < data.n; ++i) {
     // Joint i moves about or along the z axis of its axis frame.

@@ -96,6 +96,94 @@ ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters>
   }
 }
 
+namespace {
+
+const ManipulatorModel& checkedChain(const std::shared_ptr<const ManipulatorModel>& chain) {
+  if (!chain) throw std::invalid_argument("ManipulatorModel: no chain for the mimic joints");
+  if (chain->hasMimicJoints())
+    throw std::invalid_argument("ManipulatorModel '" + chain->getName() + "': the chain of a model with mimic joints has mimic joints");
+  return *chain;
+}
+
+// The model's links: the chain's independent joints, with what the mimic joints following each
+// allow (limits) and reflect onto it (friction, motor inertia).
+std::vector<LinkParameters> independentLinks(const ManipulatorModel& chain, const std::vector<JointCoupling>& coupling) {
+  const int m = chain.getNumberOfJoints();
+  const std::string model = "ManipulatorModel '" + chain.getName() + "': ";
+  if (static_cast<int>(coupling.size()) != m)
+    throw std::invalid_argument(model + std::to_string(coupling.size()) + " couplings for a chain of " + std::to_string(m) + " joints");
+  std::vector<LinkParameters> links;
+  for (int k = 0; k < m; ++k) {
+    const JointCoupling& c = coupling[static_cast<std::size_t>(k)];
+    if (c.mimic) continue;
+    if (c.joint != static_cast<int>(links.size()) || c.multiplier != 1 || c.offset != 0)
+      throw std::invalid_argument(model + "chain joint " + std::to_string(k + 1) + " is independent but coupled as joint " +
+                                  std::to_string(c.joint + 1) + " (the independent joints are numbered in chain order, multiplier 1, offset 0)");
+    links.push_back(chain.getLink(k));
+  }
+  if (links.empty()) throw std::invalid_argument(model + "every joint of the chain is a mimic joint");
+  for (int k = 0; k < m; ++k) {
+    const JointCoupling& c = coupling[static_cast<std::size_t>(k)];
+    if (!c.mimic) continue;
+    const LinkParameters& f = chain.getLink(k);
+    const std::string joint = model + "mimic joint '" + f.jointName + "': ";
+    if (c.joint < 0 || c.joint >= static_cast<int>(links.size()))
+      throw std::invalid_argument(joint + "follows joint " + std::to_string(c.joint + 1) + ", which does not exist");
+    if (!std::isfinite(c.multiplier) || !std::isfinite(c.offset)) throw std::invalid_argument(joint + "a multiplier or offset that is not finite");
+    LinkParameters& l = links[static_cast<std::size_t>(c.joint)];
+    const double a = c.multiplier, aa = std::abs(a);
+    if (a != 0) {
+      double lo = (f.positionMin - c.offset) / a, hi = (f.positionMax - c.offset) / a;
+      if (a < 0) std::swap(lo, hi);
+      l.positionMin = std::max(l.positionMin, lo);
+      l.positionMax = std::min(l.positionMax, hi);
+      if (!(l.positionMin <= l.positionMax))
+        throw std::invalid_argument(joint + "its position limits leave joint '" + l.jointName + "' no position");
+      l.velocityLimit = std::min(l.velocityLimit, f.velocityLimit / aa);
+      l.accelerationLimit = std::min(l.accelerationLimit, f.accelerationLimit / aa);
+      l.jerkLimit = std::min(l.jerkLimit, f.jerkLimit / aa);
+    } else if (c.offset < f.positionMin || c.offset > f.positionMax) {
+      throw std::invalid_argument(joint + "its offset lies outside its position limits");
+    }
+    // Joint side, tau_master += a tau_mimic(a qd): viscous a^2 B_f G_f^2, Coulomb a G_f Tc_f(sign(a qd)),
+    // armature a^2 G_f^2 Jm_f, written on the motor side of the master's gear ratio G.
+    const double G = std::abs(l.gearRatio), Gf = std::abs(f.gearRatio);
+    const bool friction = f.viscousFriction != 0 || f.coulombFrictionPositive != 0 || f.coulombFrictionNegative != 0;
+    if ((friction || f.motorInertia != 0) && a != 0 && Gf != 0) {
+      if (G == 0) throw std::invalid_argument(joint + "its friction or motor inertia cannot act through joint '" + l.jointName + "' (gear ratio 0)");
+      l.viscousFriction += a * a * Gf * Gf * f.viscousFriction / (G * G);
+      l.coulombFrictionPositive += aa * Gf * (a > 0 ? f.coulombFrictionPositive : -f.coulombFrictionNegative) / G;
+      l.coulombFrictionNegative -= aa * Gf * (a > 0 ? -f.coulombFrictionNegative : f.coulombFrictionPositive) / G;
+      l.motorInertia += a * a * Gf * Gf * f.motorInertia / (G * G);
+    }
+  }
+  return links;
+}
+
+}  // namespace
+
+ManipulatorModel::ManipulatorModel(std::shared_ptr<const ManipulatorModel> chain, std::vector<JointCoupling> coupling)
+    : ManipulatorModel(checkedChain(chain).getName(), independentLinks(*chain, coupling), chain->getBaseTransform(),
+                       chain->getToolTransform(), chain->getGravity(), chain->getConvention()) {
+  for (int k = 0; k < chain->getNumberOfJoints(); ++k)
+    if (!coupling[static_cast<std::size_t>(k)].mimic) chainIndex_.push_back(k);
+  chain_ = std::move(chain);
+  coupling_ = std::move(coupling);
+}
+
+void ManipulatorModel::toChain(const JointVector& q, JointVector& chainQ, bool offsets) const {
+  if (!chain_) {
+    chainQ = q;
+    return;
+  }
+  const int m = static_cast<int>(coupling_.size());
+  chainQ.resize(m);
+  for (int k = 0; k < m; ++k) {
+    const JointCoupling& c = coupling_[static_cast<std::size_t>(k)];
+    chainQ(k) = c.multiplier * q(c.joint) + (offsets ? c.offset : 0.0);
+  }
+}
+
 int ManipulatorModel::findJoint(const std::string& name) const {
   for (int i = 0; i < getNumberOfJoints(); ++i)
     if (getJointName(i) == name) return i;
@@ -122,6 +210,11 @@ ManipulatorData::ManipulatorData(const ManipulatorModel& model) : n(model.getNum
   for (JointVector* v : {&tau, &qdd, &scratchTau, &zero, &unitColumn, &abaD, &abaU, &bias}) v->setZero(n);
   massMatrix.setZero(n, n);
   ldl.setZero(n, n);
+  if (model.hasMimicJoints()) {
+    const ManipulatorModel& c = model.getChain();
+    chain = std::make_unique<ManipulatorData>(c);
+    for (JointVector* v : {&chainQ, &chainQd, &chainQdd, &chainTau}) v->setZero(c.getNumberOfJoints());
+  }
 }
 
 }  // namespace rp

@@ -83,6 +83,13 @@ bool isPhysicalInertia(const Matrix<3, 3>& inertia) {
 }
 
 PhysicalModel physicalModel(const ManipulatorModel& model) {
+  if (model.hasMimicJoints()) {
+    std::string mimics;
+    for (std::size_t k = 0; k < model.getCoupling().size(); ++k)
+      if (model.getCoupling()[k].mimic) mimics += (mimics.empty() ? "'" : ", '") + model.getChain().getJointName(static_cast<int>(k)) + "'";
+    throw std::invalid_argument("physicalModel: " + model.getName() + " has mimic joints on its chain (" + mimics +
+                                "); exporting them (URDF, MJCF) is not supported");
+  }
   const int n = model.getNumberOfJoints();
   std::vector<LinkParameters> links;
   double totalMass = 0, size = 0;

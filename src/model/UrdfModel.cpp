@@ -402,14 +402,15 @@ void selfCheck(const ManipulatorModel& model, const std::vector<urdf::JointConst
                const std::string& fileName) {
   const int n = model.getNumberOfJoints();
   ManipulatorData data(model);
-  JointVector q(n);
+  JointVector q(n), chainQ;
   for (int trial = 0; trial < 5; ++trial) {
     for (int i = 0; i < n; ++i) {
       const double lo = model.getPositionMin()(i), hi = model.getPositionMax()(i);
       const double fraction = trial == 0 ? -1 : std::fmod(0.6180339887498949 * (i + 1) * (trial + 2) + 0.1 * trial, 1.0);
       q(i) = trial == 0 ? std::clamp(0.0, lo, hi) : lo + fraction * (hi - lo);
     }
-    const Transform expected = walkChain(chain, q);
+    model.toChain(q, chainQ);  // mimic joints at their master's value times the multiplier plus the offset
+    const Transform expected = walkChain(chain, chainQ);
     const Transform& T = forwardKinematics(model, data, q);
     const double scale = 1 + expected.topRightCorner<3, 1>().cwiseAbs().maxCoeff();
     if (!T.allFinite() || !((T - expected).cwiseAbs().maxCoeff() <= 1e-9 * scale)) {
@@ -658,10 +659,6 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
       case urdf::Joint::REVOLUTE:
       case urdf::Joint::CONTINUOUS:
       case urdf::Joint::PRISMATIC: {
-        if (j->mimic)
-          throw UrdfError(joint + " mimics joint '" + excerpt(j->mimic->joint_name) +
-                          "': a mimic joint is no independent joint of the arm, and mimic joints on the chain are not "
-                          "supported; name a tip link before it (links moved by mimic joints off the chain are lumped)");
         V3 axis(j->axis.x, j->axis.y, j->axis.z);
         if (!axis.allFinite()) throw UrdfError(joint + " has an axis that is not finite");
         if (axis.norm() < 1e-12) throw UrdfError(joint + " has a zero axis");
@@ -731,10 +728,48 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     }
     link.body.combine(l.mass, l.com, l.inertia);
   }
+  // Mimic joints on the chain follow an independent joint of the chain (through other mimic
+  // joints: multipliers and offsets composed); they are no joints of the model.
+  std::vector<JointCoupling> coupling(static_cast<std::size_t>(n));
+  std::map<std::string, int> independent;  // joint name -> the model's joint
+  for (int k = 0; k < n; ++k) {
+    const urdf::Joint& j = *links[static_cast<std::size_t>(k)].joint;
+    if (j.mimic) continue;
+    coupling[static_cast<std::size_t>(k)].joint = static_cast<int>(independent.size());
+    independent[j.name] = static_cast<int>(independent.size());
+  }
+  for (int k = 0; k < n; ++k) {
+    const urdf::Joint* j = links[static_cast<std::size_t>(k)].joint.get();
+    if (!j->mimic) continue;
+    JointCoupling& c = coupling[static_cast<std::size_t>(k)];
+    c.mimic = true;
+    c.multiplier = 1;
+    c.offset = 0;
+    const std::string name = j->name;
+    while (j->mimic) {  // checkMimics() ruled out circles
+      c.offset += c.multiplier * j->mimic->offset;
+      c.multiplier *= j->mimic->multiplier;
+      j = robot->getJoint(j->mimic->joint_name).get();
+    }
+    const auto master = independent.find(j->name);
+    if (master == independent.end())
+      throw UrdfError(fileName + ": joint '" + excerpt(name) + "' mimics joint '" + excerpt(j->name) +
+                      "', which is not a joint of the chain; a mimic joint on the chain follows a joint of the chain");
+    c.joint = master->second;
+    if (!std::isfinite(c.multiplier) || !std::isfinite(c.offset))
+      throw UrdfError(fileName + ": joint '" + excerpt(name) + "': <mimic> multiplier or offset is not finite when composed");
+  }
   std::unique_ptr<ManipulatorModel> model;
   try {
-    model = std::make_unique<ManipulatorModel>(robot->getName(), parameters, Transform::unit(), C,
-                                               ManipulatorModel::standardGravity(), DHConvention::Placement);
+    if (independent.size() == static_cast<std::size_t>(n)) {
+      model = std::make_unique<ManipulatorModel>(robot->getName(), parameters, Transform::unit(), C,
+                                                 ManipulatorModel::standardGravity(), DHConvention::Placement);
+    } else {
+      model = std::make_unique<ManipulatorModel>(
+          std::make_shared<const ManipulatorModel>(robot->getName(), parameters, Transform::unit(), C,
+                                                   ManipulatorModel::standardGravity(), DHConvention::Placement),
+          std::move(coupling));
+    }
   } catch (const std::invalid_argument& e) {  // whatever the model itself refuses, named by file
     throw UrdfError(fileName + ": " + e.what());
   }

@@ -70,4 +70,23 @@ describe('URDF visuals of a UrdfManipulator', () => {
     assert.deepEqual(page.rpErrors, []);
     await page.close();
   });
+
+  // Issue 20: the panels label the joints with the URDF's names (j1, j2, j3), not "Joint 1".
+  it('labels the joints with their URDF names in Joint Move and the control panel', async () => {
+    await waitInPage(ctx.page, () => document.querySelectorAll('#sliders .slider-row').length === 3);
+    assert.deepEqual(await ctx.page.evaluate(() => [...document.querySelectorAll('#sliders .slider-row .joint-name')]
+      .map((e) => e.textContent)), ['j1', 'j2', 'j3']);
+    const page = await openViewer(ctx.browser, ctx.url.replace('jointmove.html', 'index.html'));
+    assert.deepEqual(await page.evaluate(() => window.rp.scene.objects.find((o) => o.name === 'arm').jointNames),
+      ['j1', 'j2', 'j3']);
+    await page.evaluate(() => window.rp.openPanel('arm'));
+    const panel = page.locator('.panel[data-panel="arm"]');
+    await panel.locator('.joint-names .joint-name').first().waitFor({ timeout: 10000 });
+    assert.deepEqual(await panel.locator('.joint-names .joint-name').allTextContents(), ['j1', 'j2', 'j3']);
+    // Each per-joint value names its joint (the gains typed per joint, the positions read out).
+    assert.deepEqual(await panel.locator('input[data-field="kp"]').evaluateAll((es) => es.map((e) => e.dataset.joint)),
+      ['j1', 'j2', 'j3']);
+    assert.deepEqual(page.rpErrors, []);
+    await page.close();
+  });
 });

@@ -139,6 +139,96 @@ TEST(UrdfVisuals, FollowTheDefaultTipOfTheModel) {
   std::filesystem::remove(file);
 }
 
+// Issue 20: a mimic joint on the chain moves its link with its master. The shapes hang on the
+// chain's frames (`chainK`), and placed by the chain frames of the model's forward kinematics
+// (what the Scene Viewer sends) they land where the URDF written out by hand puts them, the
+// elbow at -shoulder + 0.2.
+TEST(UrdfVisuals, LinksOfMimicJointsMoveWithTheirMaster) {
+  const std::string file = (std::filesystem::temp_directory_path() / "rp_urdf_visuals_mimic.urdf").string();
+  auto box = [](const char* x) { return std::string("<visual><origin xyz=\"") + x + " 0 0\"/><geometry><box size=\"0.1 0.05 0.05\"/></geometry></visual>"; };
+  const std::string limit = "<limit lower=\"-2\" upper=\"2\" effort=\"1\" velocity=\"1\"/>";
+  std::ofstream(file) << "<robot name=\"mimic\"><link name=\"base\"/><link name=\"upper\">" << box("0.15")
+                      << "</link><link name=\"fore\">" << box("0.1") << "</link><link name=\"hand\">" << box("0.05")
+                      << "</link><joint name=\"shoulder\" type=\"revolute\"><parent link=\"base\"/><child link=\"upper\"/>"
+                         "<axis xyz=\"0 0 1\"/>" << limit << "</joint>"
+                         "<joint name=\"elbow\" type=\"revolute\"><parent link=\"upper\"/><child link=\"fore\"/>"
+                         "<origin xyz=\"0.3 0 0\"/><axis xyz=\"0 0 1\"/>" << limit
+                      << "<mimic joint=\"shoulder\" multiplier=\"-1\" offset=\"0.2\"/></joint>"
+                         "<joint name=\"wrist\" type=\"revolute\"><parent link=\"fore\"/><child link=\"hand\"/>"
+                         "<origin xyz=\"0.25 0 0\"/><axis xyz=\"0 1 0\"/>" << limit << "</joint></robot>";
+  const auto model = rp::loadUrdf(file);
+  ASSERT_EQ(model->getNumberOfJoints(), 2);  // shoulder and wrist; the elbow follows the shoulder
+  const auto shapes = rp::loadUrdfVisuals(file);
+  ASSERT_EQ(shapes.size(), 3u);
+  EXPECT_EQ(shapes[0].frame, "chain1");
+  EXPECT_EQ(shapes[1].frame, "chain2");
+  EXPECT_EQ(shapes[2].frame, "chain3");
+  rp::ManipulatorData data(*model);
+  ASSERT_NE(data.chain, nullptr);
+  for (const double q1 : {0.0, 0.7, -1.1}) {
+    const double q2 = 0.5 - q1;
+    rp::JointVector q(2);
+    q << q1, q2;
+    rp::forwardKinematics(*model, data, q);
+    const rp::Transform l1 = rotZ(q1);
+    const rp::Transform l2 = rp::Transform(l1 * rp::translation(0.3, 0, 0) * rotZ(-q1 + 0.2));
+    const rp::Transform l3 = rp::Transform(l2 * rp::translation(0.25, 0, 0) * rotY(q2));
+    const rp::Transform expected[3] = {rp::Transform(l1 * rp::translation(0.15, 0, 0)), rp::Transform(l2 * rp::translation(0.1, 0, 0)),
+                                       rp::Transform(l3 * rp::translation(0.05, 0, 0))};
+    for (std::size_t i = 0; i < 3; ++i) {
+      const rp::Transform frame = data.chain->linkTransforms[static_cast<std::size_t>(std::stoi(shapes[i].frame.substr(5)) - 1)];
+      EXPECT_LT((rp::Transform(frame * shapes[i].pose) - expected[i]).cwiseAbs().maxCoeff(), 1e-12) << "shape " << i << " at q1 " << q1;
+    }
+  }
+  std::filesystem::remove(file);
+}
+
+// Issue 20: links moved by joints off the chain (two fingers, the second a mimic) are drawn, on
+// the chain link they hang on, where loadUrdf() lumps them (and says so in a note): at the
+// fingers' lower limit 0.01 m (zero is outside it), the mimic finger at -0.5 * master + 0.05
+// along its own axis. They used to be left out.
+TEST(UrdfVisuals, MovingLinksOffTheChainAreDrawnWhereTheyAreLumped) {
+  const std::string file = (std::filesystem::temp_directory_path() / "rp_urdf_visuals_fingers.urdf").string();
+  const std::string box = "<visual><geometry><box size=\"0.02 0.02 0.06\"/></geometry></visual>";
+  const std::string inertial = "<inertial><mass value=\"0.1\"/><inertia ixx=\"1e-4\" ixy=\"0\" ixz=\"0\" iyy=\"1e-4\" iyz=\"0\" izz=\"1e-4\"/></inertial>";
+  const std::string limit = "<limit lower=\"0.01\" upper=\"0.04\" effort=\"10\" velocity=\"0.1\"/>";
+  std::ofstream(file) << "<robot name=\"fingers\"><link name=\"base\"/><link name=\"upper\">" << inertial
+                      << "</link><link name=\"hand\">" << box << "</link><link name=\"left_finger\">" << box << inertial
+                      << "</link><link name=\"right_finger\">" << box << inertial
+                      << "</link><joint name=\"shoulder\" type=\"revolute\"><parent link=\"base\"/><child link=\"upper\"/>"
+                         "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>"
+                         "<joint name=\"mount\" type=\"fixed\"><parent link=\"upper\"/><child link=\"hand\"/>"
+                         "<origin xyz=\"0.3 0 0\" rpy=\"0 1.5707963267948966 0\"/></joint>"
+                         "<joint name=\"finger_left\" type=\"prismatic\"><parent link=\"hand\"/><child link=\"left_finger\"/>"
+                         "<origin xyz=\"0 0 0.05\"/><axis xyz=\"0 1 0\"/>" << limit << "</joint>"
+                      << "<joint name=\"finger_right\" type=\"prismatic\"><parent link=\"hand\"/><child link=\"right_finger\"/>"
+                         "<origin xyz=\"0 0 0.05\"/><axis xyz=\"0 -1 0\"/>" << limit
+                      << "<mimic joint=\"finger_left\" multiplier=\"-0.5\" offset=\"0.05\"/></joint></robot>";
+  std::vector<std::string> notes;
+  rp::UrdfOptions modelOptions;
+  modelOptions.notes = &notes;
+  ASSERT_EQ(rp::loadUrdf(file, modelOptions)->getNumberOfJoints(), 1);  // the fingers are lumped...
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("links 'left_finger', 'right_finger' move off the chain: their mass is lumped into 'upper'"),
+            std::string::npos) << notes[0];  // ... and the loader says so
+  const rp::Transform hand = rp::Transform(rp::translation(0.3, 0, 0) * rotY(1.5707963267948966));
+  {
+    const double left = 0.01;
+    const auto visuals = rp::readUrdfVisuals(file, rp::UrdfVisualOptions());
+    ASSERT_EQ(visuals.size(), 3u);
+    const double right = -0.5 * left + 0.05;
+    const rp::Transform expected[3] = {hand, rp::Transform(hand * rp::translation(0, left, 0.05)),
+                                       rp::Transform(hand * rp::translation(0, -right, 0.05))};
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ(visuals[i].shape.frame, "link1");
+      EXPECT_LT((visuals[i].shape.pose - expected[i]).cwiseAbs().maxCoeff(), 1e-12) << visuals[i].link << " at " << left;
+    }
+    EXPECT_EQ(visuals[1].link, "left_finger");
+    EXPECT_EQ(visuals[2].link, "right_finger");
+  }
+  std::filesystem::remove(file);
+}
+
 // The mesh arm of the browser test, in its package folder rp_mesh_arm (package:// URIs).
 const std::string kPackages = std::string(RP_TEST_DATA_DIR) + "/packages";
 const std::string kMeshArm = kPackages + "/rp_mesh_arm/urdf/mesh_arm.urdf";

@@ -53,6 +53,10 @@ struct KdlArm {
   KDL::Chain chain;
   int joints = 0;
   bool allInertial = true;  // the child link of every movable joint has inertial data
+  // Per movable chain joint: the independent joint that moves it (its own name unless a mimic,
+  // mimics of mimics followed to the end), and the multiplier and offset from it.
+  std::vector<std::string> master;
+  std::vector<double> multiplier, offset;
 };
 
 // The value at which a moving joint off the chain is lumped: zero within its limits, or for a
@@ -102,6 +106,15 @@ KdlArm kdlArm(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip
     } else {
       if (!any) arm.allInertial = false;
       ++arm.joints;
+      double a = 1, b = 0;
+      urdf::JointConstSharedPtr m = j;
+      for (; m->mimic; m = robot->getJoint(m->mimic->joint_name)) {
+        b += a * m->mimic->offset;
+        a *= m->mimic->multiplier;
+      }
+      arm.master.push_back(m->name);
+      arm.multiplier.push_back(a);
+      arm.offset.push_back(b);
       const KDL::Vector axis = origin.M * KDL::Vector(j->axis.x, j->axis.y, j->axis.z);
       const KDL::Joint::JointType type = j->type == urdf::Joint::PRISMATIC ? KDL::Joint::TransAxis : KDL::Joint::RotAxis;
       arm.chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, origin.p, axis / axis.Norm(), type), origin, inertia));
@@ -130,7 +143,18 @@ struct Agreement {
 };
 
 Agreement compare(const ManipulatorModel& model, const KdlArm& arm, int trials, unsigned seed) {
-  const int n = model.getNumberOfJoints();
+  const int n = model.getNumberOfJoints(), m = arm.joints;
+  // The chain's joint values are S q + o (mimic joints follow their master): KDL computes on the
+  // whole chain, and J S, S^T g, S^T tau and S^T M S are the model's.
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(m, n);
+  Eigen::VectorXd o(m);
+  for (int k = 0; k < m; ++k) {
+    const int i = model.findJoint(arm.master[static_cast<std::size_t>(k)]);
+    EXPECT_GE(i, 0) << arm.master[static_cast<std::size_t>(k)];
+    if (i < 0) return {};
+    S(k, i) = arm.multiplier[static_cast<std::size_t>(k)];
+    o(k) = arm.offset[static_cast<std::size_t>(k)];
+  }
   KDL::ChainFkSolverPos_recursive fk(arm.chain);
   KDL::ChainJntToJacSolver jac(arm.chain);
   KDL::ChainIdSolver_RNE id(arm.chain, KDL::Vector(0, 0, -9.81));
@@ -146,7 +170,9 @@ Agreement compare(const ManipulatorModel& model, const KdlArm& arm, int trials, 
       qd(i) = 2 * u(rng) - 1;
       qdd(i) = 4 * u(rng) - 2;
     }
-    const KDL::JntArray kq = test::kdlJoints(q), kqd = test::kdlJoints(qd), kqdd = test::kdlJoints(qdd);
+    const Eigen::VectorXd fq = S * Eigen::VectorXd(q) + o, fqd = S * Eigen::VectorXd(qd), fqdd = S * Eigen::VectorXd(qdd);
+    const KDL::JntArray kq = test::kdlJoints(JointVector(fq)), kqd = test::kdlJoints(JointVector(fqd)),
+                       kqdd = test::kdlJoints(JointVector(fqdd));
     KDL::Frame f;
     fk.JntToCart(kq, f);
     Eigen::Matrix<double, 3, 4> kf;
@@ -157,25 +183,29 @@ Agreement compare(const ManipulatorModel& model, const KdlArm& arm, int trials, 
     const Transform& T = forwardKinematics(model, data, q);
     w.finite = w.finite && T.allFinite();
     w.fk = std::max(w.fk, relative(T, kf, 3, 4));
-    KDL::Jacobian kj(static_cast<unsigned>(n));
+    KDL::Jacobian kj(static_cast<unsigned>(m));
     jac.JntToJac(kq, kj);
     const Jacobian& J = jacobian(model, data, q);
     w.finite = w.finite && J.allFinite();
-    w.jacobian = std::max(w.jacobian, relative(J, kj.data, 6, n));
+    const Eigen::MatrixXd kJ = kj.data * S;
+    w.jacobian = std::max(w.jacobian, relative(J, kJ, 6, n));
     if (!arm.allInertial) continue;
-    KDL::JntArray kg(static_cast<unsigned>(n)), ktau(static_cast<unsigned>(n));
+    KDL::JntArray kg(static_cast<unsigned>(m)), ktau(static_cast<unsigned>(m));
     dyn.JntToGravity(kq, kg);
     JointVector g(n);
     gravityTorque(model, data, q, g);
-    w.gravity = std::max(w.gravity, relative(g, kg.data, n, 1));
+    const Eigen::VectorXd kG = S.transpose() * kg.data;
+    w.gravity = std::max(w.gravity, relative(g, kG, n, 1));
     KDL::Wrenches wrenches(arm.chain.getNrOfSegments(), KDL::Wrench::Zero());
     id.CartToJnt(kq, kqd, kqdd, wrenches, ktau);
     const JointVector& tau = inverseDynamics(model, data, q, qd, qdd);
-    w.rnea = std::max(w.rnea, relative(tau, ktau.data, n, 1));
-    KDL::JntSpaceInertiaMatrix km(static_cast<unsigned>(n));
+    const Eigen::VectorXd kTau = S.transpose() * ktau.data;
+    w.rnea = std::max(w.rnea, relative(tau, kTau, n, 1));
+    KDL::JntSpaceInertiaMatrix km(static_cast<unsigned>(m));
     dyn.JntToMass(kq, km);
     const JointMatrix& M = massMatrix(model, data, q);
-    w.mass = std::max(w.mass, relative(M, km.data, n, n));
+    const Eigen::MatrixXd kM = S.transpose() * km.data * S;
+    w.mass = std::max(w.mass, relative(M, kM, n, n));
     w.finite = w.finite && g.allFinite() && tau.allFinite() && M.allFinite();
   }
   return w;
@@ -187,12 +217,12 @@ std::unique_ptr<ManipulatorModel> load(const std::string& file, const std::strin
   return loadUrdf(kData + "/" + file, options);
 }
 
-void expectExact(const std::string& file, const std::string& tip, int joints) {
+void expectExact(const std::string& file, const std::string& tip, int joints, int chainJoints = 0) {
   SCOPED_TRACE(file + " to " + tip);
   const std::unique_ptr<ManipulatorModel> model = load(file, tip);
   ASSERT_EQ(model->getNumberOfJoints(), joints);
   const KdlArm arm = kdlArm(parse(kData + "/" + file), tip);
-  ASSERT_EQ(arm.joints, joints);
+  ASSERT_EQ(arm.joints, chainJoints > 0 ? chainJoints : joints);
   const Agreement w = compare(*model, arm, 300, 11);
   EXPECT_TRUE(w.finite);
   EXPECT_LT(w.fk, 1e-12);
@@ -249,6 +279,108 @@ TEST(UrdfExactness, JacobianIsTheDerivativeOfTheForwardKinematics) {
   }
 }
 
+// Mimic joints on the chain (issue 20): a parallel-link elbow (multiplier -1, offset 0.3) and a
+// coupled wrist (a mimic, and a mimic of that mimic) are no joints of the model; kinematics and
+// dynamics are KDL's on the whole chain with the mimic joints at multiplier * master + offset,
+// mapped back (J S, S^T g, S^T tau, S^T M S).
+TEST(UrdfExactness, MimicJointsOnTheChainFollowTheirMaster) {
+  expectExact("mimic_arm.urdf", "tool", 4, 7);
+  const std::unique_ptr<ManipulatorModel> model = load("mimic_arm.urdf", "tool");
+  ASSERT_TRUE(model->hasMimicJoints());
+  EXPECT_EQ(model->getJointName(0), "base_yaw");
+  EXPECT_EQ(model->getJointName(1), "shoulder");
+  EXPECT_EQ(model->getJointName(2), "wrist_roll");
+  EXPECT_EQ(model->getJointName(3), "slide");
+  EXPECT_EQ(model->findJoint("elbow_link"), -1);
+  EXPECT_EQ(model->getChain().getNumberOfJoints(), 7);
+  EXPECT_EQ(model->getChainIndex(2), 3);
+  const JointCoupling& yaw = model->getCoupling()[5];  // wrist_yaw = -2 (0.5 roll - 0.1)
+  EXPECT_TRUE(yaw.mimic);
+  EXPECT_EQ(yaw.joint, 2);
+  EXPECT_DOUBLE_EQ(yaw.multiplier, -1);
+  EXPECT_DOUBLE_EQ(yaw.offset, 0.2);
+  // The elbow's limits [-1, 1.6] at -shoulder + 0.3 leave the shoulder [-1.2, 1.3] (its own: 1.5).
+  EXPECT_DOUBLE_EQ(model->getPositionMin()(1), -1.2);
+  EXPECT_DOUBLE_EQ(model->getPositionMax()(1), 1.3);
+  EXPECT_DOUBLE_EQ(model->getVelocityLimit()(1), 1.5);  // the elbow's 1.5 rad/s at multiplier -1
+}
+
+// With mimic joints, the Jacobian is the derivative of the forward kinematics and the gravity
+// torque that of the potential energy of every chain link (central differences); forward
+// dynamics (composite rigid body and articulated body) inverts the inverse dynamics; friction of
+// the mimic joints acts on their master (frictionTorque() equals inverse dynamics with minus
+// without friction).
+TEST(UrdfExactness, MimicArmAgreesWithFiniteDifferencesAndItsOwnInverse) {
+  const std::unique_ptr<ManipulatorModel> model = load("mimic_arm.urdf", "tool");
+  const ManipulatorModel& chain = model->getChain();
+  const int n = model->getNumberOfJoints();
+  ManipulatorData data(*model), probe(*model);
+  auto potential = [&](const JointVector& q) {
+    forwardKinematics(*model, probe, q);
+    double U = 0;
+    for (int k = 0; k < chain.getNumberOfJoints(); ++k) {
+      const Transform& T = probe.chain->linkTransforms[static_cast<std::size_t>(k)];
+      const Eigen::Vector3d c = T.topLeftCorner<3, 3>() * Eigen::Vector3d(chain.getLink(k).com) + T.topRightCorner<3, 1>();
+      U -= chain.getLink(k).mass * Eigen::Vector3d(model->getGravity()).dot(c);
+    }
+    return U;
+  };
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  double worstJ = 0, worstG = 0, worstFd = 0, worstAba = 0, worstFriction = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    JointVector q(n), qd(n), tau(n);
+    for (int i = 0; i < n; ++i) {
+      q(i) = model->getPositionMin()(i) + u(rng) * (model->getPositionMax()(i) - model->getPositionMin()(i));
+      qd(i) = 2 * u(rng) - 1;
+      tau(i) = 20 * u(rng) - 10;
+    }
+    const Jacobian J = jacobian(*model, data, q);
+    JointVector g(n);
+    gravityTorque(*model, data, q, g);
+    const double h = 1e-6;
+    for (int i = 0; i < n; ++i) {
+      JointVector qp = q, qm = q;
+      qp(i) += h;
+      qm(i) -= h;
+      const Transform Tp = forwardKinematics(*model, probe, qp);
+      const Transform Tm = forwardKinematics(*model, probe, qm);
+      const Eigen::Vector3d v = (Tp.topRightCorner<3, 1>() - Tm.topRightCorner<3, 1>()) / (2 * h);
+      const Eigen::Matrix3d dR = (Tp.topLeftCorner<3, 3>() - Tm.topLeftCorner<3, 3>()) / (2 * h);
+      const Eigen::Matrix3d W = dR * data.endEffector.topLeftCorner<3, 3>().transpose();  // skew(w)
+      const Eigen::Vector3d w(W(2, 1), W(0, 2), W(1, 0));
+      worstJ = std::max({worstJ, (J.block<3, 1>(0, i) - v).norm(), (J.block<3, 1>(3, i) - w).norm()});
+      worstG = std::max(worstG, std::abs(g(i) - (potential(qp) - potential(qm)) / (2 * h)));
+    }
+    DynamicsOptions options;
+    options.friction = true;
+    options.motorInertia = true;
+    const JointVector qdd = forwardDynamics(*model, data, q, qd, tau, options);
+    worstFd = std::max(worstFd, (inverseDynamics(*model, data, q, qd, qdd, options) - tau).cwiseAbs().maxCoeff());
+    const JointVector qddAba = forwardDynamicsArticulatedBody(*model, data, q, qd, tau, options);
+    worstAba = std::max(worstAba, (qddAba - qdd).cwiseAbs().maxCoeff());
+    DynamicsOptions noFriction = options;
+    noFriction.friction = false;
+    const JointVector withFriction = inverseDynamics(*model, data, q, qd, qdd, options);
+    const JointVector without = inverseDynamics(*model, data, q, qd, qdd, noFriction);
+    JointVector f(n);
+    frictionTorque(*model, qd, f);
+    worstFriction = std::max(worstFriction, (withFriction - without - f).cwiseAbs().maxCoeff());
+  }
+  std::printf("mimic arm: J vs differences %.1e, g vs dU/dq %.1e, ID(FD(tau)) - tau %.1e N m, ABA - CRBA %.1e, friction %.1e\n",
+              worstJ, worstG, worstFd, worstAba, worstFriction);
+  EXPECT_LT(worstJ, 1e-8);
+  EXPECT_LT(worstG, 1e-6);
+  EXPECT_LT(worstFd, 1e-10);
+  EXPECT_LT(worstAba, 1e-12);
+  EXPECT_LT(worstFriction, 1e-12);
+  // The shoulder's friction includes the parallel link's: damping 0.4 + 0.2, Coulomb 1.5 + 0.7.
+  JointVector qd = JointVector::Zero(n), f(n);
+  qd(1) = 2;
+  frictionTorque(*model, qd, f);
+  EXPECT_NEAR(f(1), 0.6 * 2 + 2.2, 1e-12);
+}
+
 // Every leaf link of every test description as the tip: loads and agrees with KDL, or is refused
 // with a message that names the file; never a NaN.
 TEST(UrdfExactness, EveryLeafOfEveryTestDescriptionLoadsExactlyOrIsRefused) {
@@ -274,7 +406,7 @@ TEST(UrdfExactness, EveryLeafOfEveryTestDescriptionLoadsExactlyOrIsRefused) {
       }
       ++loaded;
       const KdlArm arm = kdlArm(robot, name);
-      ASSERT_EQ(arm.joints, model->getNumberOfJoints());
+      ASSERT_EQ(arm.joints, model->getChain().getNumberOfJoints());
       const Agreement w = compare(*model, arm, 40, 5);
       EXPECT_TRUE(w.finite);
       EXPECT_LT(std::max({w.fk, w.jacobian, w.gravity, w.rnea, w.mass}), 1e-12);

@@ -402,10 +402,41 @@ TEST(UrdfModel, MovingLinksOffTheChainAreLumpedAtTheStatedConfiguration) {
   EXPECT_EQ(error(f), f + ": joint 'finger_joint2' mimics joint 'no_such_joint', which does not exist");
   f = variant("<mimic joint=\"finger_joint1\"/>", "<mimic joint=\"finger_joint2\"/>");
   EXPECT_EQ(error(f), f + ": joint 'finger_joint2' mimics 'finger_joint2': the mimic joints go round in a circle");
+  // The right finger as the tip puts the mimic finger_joint2 on the chain, its master off it.
   EXPECT_EQ(error(kData + "/panda_like.urdf", "rightfinger"),
-            kData + "/panda_like.urdf: joint 'finger_joint2' mimics joint 'finger_joint1': a mimic joint is no "
-                    "independent joint of the arm, and mimic joints on the chain are not supported; name a tip link "
-                    "before it (links moved by mimic joints off the chain are lumped)");
+            kData + "/panda_like.urdf: joint 'finger_joint2' mimics joint 'finger_joint1', which is not a joint of the "
+                    "chain; a mimic joint on the chain follows a joint of the chain");
+}
+
+// A mimic joint on the chain that names a missing joint is refused, naming the file and both
+// joints; one whose limits leave its master no position too; the arm loads with its own mimics.
+TEST(UrdfModel, MimicJointOnTheChainNamingAMissingJointIsRefused) {
+  std::ifstream in(kData + "/mimic_arm.urdf");
+  std::stringstream text;
+  text << in.rdbuf();
+  auto variant = [&](const std::string& from, const std::string& to) {
+    std::string t = text.str();
+    const std::size_t at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    t.replace(at, from.size(), to);
+    const std::string file = testing::TempDir() + "/mimic_variant.urdf";
+    std::ofstream(file) << t;
+    return file;
+  };
+  auto error = [](const std::string& file) -> std::string {
+    try {
+      loadUrdf(file);
+    } catch (const UrdfError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(error(kData + "/mimic_arm.urdf"), "no error");
+  std::string f = variant("<mimic joint=\"shoulder\"", "<mimic joint=\"shoulder_motor\"");
+  EXPECT_EQ(error(f), f + ": joint 'elbow_link' mimics joint 'shoulder_motor', which does not exist");
+  f = variant("<mimic joint=\"shoulder\" multiplier=\"-1\" offset=\"0.3\"/>", "<mimic joint=\"shoulder\" offset=\"5\"/>");
+  EXPECT_EQ(error(f), f + ": ManipulatorModel 'mimic_arm': mimic joint 'elbow_link': its position limits leave joint "
+                          "'shoulder' no position");
 }
 
 // Issue 19: bad URDF files never hang or crash the process.

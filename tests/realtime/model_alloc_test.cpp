@@ -116,11 +116,13 @@ TEST(ModelRealtime, PrismaticAndModifiedDhAlgorithmsDoNotAllocate) {
 }
 
 // Issue 20: an arm loaded from URDF (the Placement form) runs every algorithm without allocating.
-TEST(ModelRealtime, UrdfArmAlgorithmsDoNotAllocate) {
+// Every algorithm on a URDF arm, `count` times, counting allocations.
+void expectUrdfArmDoesNotAllocate(const std::string& file, const std::string& tip) {
+  SCOPED_TRACE(file);
   UrdfOptions options;
-  options.tip = "tool0";
+  options.tip = tip;
   options.requireDynamics = true;
-  const std::unique_ptr<ManipulatorModel> arm = loadUrdf(RP_TEST_MODEL_DATA "/noisy_axes_arm.urdf", options);
+  const std::unique_ptr<ManipulatorModel> arm = loadUrdf(std::string(RP_TEST_MODEL_DATA "/") + file, options);
   const int n = arm->getNumberOfJoints();
   ManipulatorData d(*arm);
   JointVector q(n), qd(n), qdd(n), out(n);
@@ -151,6 +153,15 @@ TEST(ModelRealtime, UrdfArmAlgorithmsDoNotAllocate) {
   }
   EXPECT_EQ(guard.count(), 0u);
   EXPECT_TRUE(std::isfinite(sink));
+}
+
+TEST(ModelRealtime, UrdfArmAlgorithmsDoNotAllocate) { expectUrdfArmDoesNotAllocate("noisy_axes_arm.urdf", "tool0"); }
+
+// Issue 20: with mimic joints on the chain the algorithms work on the whole chain and map back,
+// in the data's own storage.
+TEST(ModelRealtime, MimicArmAlgorithmsDoNotAllocate) {
+  expectUrdfArmDoesNotAllocate("mimic_arm.urdf", "tool");
+  ASSERT_TRUE(loadUrdf(RP_TEST_MODEL_DATA "/mimic_arm.urdf")->hasMimicJoints());
 }
 
 }  // namespace

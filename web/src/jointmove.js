@@ -2,7 +2,7 @@
 // new target to the rp-jointmove program, whose trajectory generator the arm follows at once.
 import './style.css';
 import { Connection } from './connection.js';
-import { notify, showStatus } from './ui.js';
+import { jointLabels, notify, showStatus } from './ui.js';
 import { SceneView } from './scene.js';
 
 const params = new URLSearchParams(location.search);
@@ -22,6 +22,7 @@ function build(desc) {
   rows = [];
   const deg = 180 / Math.PI;
   const children = [];
+  const names = jointLabels(desc);
   for (let i = 0; i < desc.joints; ++i) {
     const input = document.createElement('input');
     input.type = 'range';
@@ -34,7 +35,9 @@ function build(desc) {
     input.dataset.joint = String(i);
     input.value = '0';
     const label = document.createElement('span');
-    label.textContent = `Joint ${i + 1}`;
+    label.className = 'joint-name';
+    label.textContent = names[i];
+    input.title = names[i];
     const value = document.createElement('span');
     value.className = 'value';
     value.textContent = '-';

@@ -1,6 +1,6 @@
 // Object List window, the object pop-up menu (Figure 17) and control panels (Figure 18),
 // rendered from the scene description and the state frames.
-import { parseNumberInput } from './ui.js';
+import { jointLabels, parseNumberInput } from './ui.js';
 
 function el(tag, attrs = {}, ...children) {
   const e = document.createElement(tag);
@@ -109,6 +109,14 @@ export class ControlPanel {
     this.inputs = [];
     this.cells = [];
     const rows = [];
+    // A manipulator's per-joint vectors: a first row names the joints above their columns, and
+    // each value's tooltip names its joint (the URDF's names, or joint1, joint2, ...).
+    const names = jointLabels(desc);
+    const perJoint = (f) => names && f.kind === 'vector' && f.size === names.length;
+    if (names && desc.panel.fields.some(perJoint)) {
+      rows.push(el('div', { class: 'row joint-names' }, el('label', {}, 'joint'),
+        el('div', { class: 'values' }, ...names.map((name) => el('span', { class: 'joint-name', title: name }, name)))));
+    }
     for (const f of desc.panel.fields) {
       if (f.name === 'errorCode') continue;
       const n = f.kind === 'vector' ? f.size : 1;
@@ -126,8 +134,12 @@ export class ControlPanel {
           const input = el('input', { type: 'text', inputmode: 'decimal', autocomplete: 'off', spellcheck: 'false',
             'data-field': f.name, 'data-index': String(i) });
           if (f.value) input.value = f.value[i];
-          if (f.max > f.min) input.title = `${f.min} to ${f.max}`;
-          const label = f.kind === 'vector' ? `${f.name}[${i + 1}]` : f.name;
+          if (f.max > f.min) input.title = `${perJoint(f) ? `${names[i]}: ` : ''}${f.min} to ${f.max}`;
+          else if (perJoint(f)) input.title = names[i];
+          // kp[shoulder] for a named joint (a URDF arm), kp[3] for a built-in arm's third.
+          const named = perJoint(f) && desc.jointNames && desc.jointNames[i] !== `joint${i + 1}`;
+          const label = f.kind === 'vector' ? `${f.name}[${named ? names[i] : i + 1}]` : f.name;
+          if (perJoint(f)) input.dataset.joint = names[i];
           input.addEventListener('change', () => {
             // Refused in the page: never send a value the user did not type (an empty or
             // malformed box used to go out as 0).
@@ -153,6 +165,10 @@ export class ControlPanel {
       } else if (f.stateIndex >= 0) {
         for (let i = 0; i < n; ++i) {
           const span = el('span', { class: 'value', 'data-field': f.name, 'data-index': String(i) }, '-');
+          if (perJoint(f)) {
+            span.title = names[i];
+            span.dataset.joint = names[i];
+          }
           cell.append(span);
           this.cells.push({ span, index: f.stateIndex + i, field: f });
         }

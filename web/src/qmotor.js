@@ -5,7 +5,7 @@ import uPlot from 'uplot';
 import './style.css';
 import { Connection } from './connection.js';
 import { ControlPanel } from './panels.js';
-import { notify, showStatus } from './ui.js';
+import { jointLabels, notify, showStatus } from './ui.js';
 
 const params = new URLSearchParams(location.search);
 const select = document.getElementById('object');
@@ -58,10 +58,13 @@ function buildFields(desc) {
 
 function buildSeries(desc) {
   series = [];
+  // A per-joint vector of an arm with named joints (a URDF arm) plots as q[shoulder], ...
+  const names = jointLabels(desc);
+  const named = (f, i) => names && f.size === names.length && desc.jointNames && desc.jointNames[i] !== `joint${i + 1}`;
   for (const f of desc.panel.fields)
     if (chosen.has(f.name) && f.stateIndex >= 0)
       for (let i = 0; i < (f.kind === 'vector' ? f.size : 1); ++i)
-        series.push({ label: f.kind === 'vector' ? `${f.name}[${i}]` : f.name, index: f.stateIndex + i });
+        series.push({ label: f.kind === 'vector' ? `${f.name}[${named(f, i) ? names[i] : i}]` : f.name, index: f.stateIndex + i });
   makePlot();
 }
 

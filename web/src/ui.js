@@ -69,3 +69,13 @@ export function addEmergencyStop(conn) {
   });
   toolbar.prepend(button);
 }
+
+// The labels of a manipulator's joints from its description: the model's joint names (a URDF
+// arm's own), with the default names joint1, joint2, ... of the built-in arms shown as
+// "Joint 1", "Joint 2", ...; null for an object that is no manipulator.
+export function jointLabels(desc) {
+  if (!desc || !(desc.joints > 0)) return null;
+  const names = Array.isArray(desc.jointNames) && desc.jointNames.length === desc.joints ? desc.jointNames : [];
+  return Array.from({ length: desc.joints }, (_, i) =>
+    (names[i] && names[i] !== `joint${i + 1}` ? names[i] : `Joint ${i + 1}`));
+}

@@ -41,8 +41,11 @@ struct UrdfVisual {
 /// Reads the `<visual>` elements of the links of a URDF arm and returns them as shapes attached
 /// to the frames of the manipulator model loadUrdf() makes of the same file and tip: a link
 /// before the first movable joint goes to frame `base`, a link after the k-th movable joint of
-/// the chain (including links fixed to it) to frame `linkk`, with the constant pose of the visual
-/// in that frame. Links on branches with movable joints of their own (not modelled) are left out.
+/// the chain (including links fixed to it) to frame `linkk` (with mimic joints on the chain: the
+/// k-th chain joint's frame `chaink`), with the constant pose of the visual in that frame. Links
+/// moved by joints off the chain (fingers, a jaw) go to the frame of the chain link they hang on,
+/// at the configuration where loadUrdf() lumps them by default (zero within the joint's limits, a
+/// mimic joint following its master).
 /// Boxes, cylinders (along z, as in URDF), spheres and meshes (scaled by `scale`) keep their
 /// sizes; mesh file names are resolved by resolveMeshUri(). Colours come from the visual's
 /// material or the robot's material of that name (default grey).

@@ -3,6 +3,7 @@
 /// Results and scratch space of the kinematics and dynamics algorithms for one thread.
 
 #include <array>
+#include <memory>
 
 #include <Eigen/Cholesky>
 
@@ -32,6 +33,11 @@ struct ManipulatorData {
   JointVector qdd;         ///< (n x 1) result of forwardDynamics() [rad/s^2]
   JointMatrix massMatrix;  ///< (n x n) from the last massMatrix() or forwardDynamics() [kg m^2]
 
+  /// For a model with mimic joints: the data of its full chain (ManipulatorModel::getChain()),
+  /// where the algorithms compute before mapping back; its `linkTransforms` include the links
+  /// the mimic joints move (for drawing). Null for a model without mimic joints.
+  std::unique_ptr<ManipulatorData> chain;
+
   /// @cond INTERNAL
   // Scratch of the recursive Newton-Euler algorithm, per link, in link coordinates.
   std::array<Matrix<3, 3>, kMaxJoints> R;       // rotation of A_i
@@ -51,6 +57,8 @@ struct ManipulatorData {
   std::array<Matrix<3, 3>, kMaxJoints> originInertia;
   JointVector bias;  // h(q, qd) of the last forwardDynamics()
   JointMatrix ldl;   // massMatrix = L D L^T: L strictly below the diagonal (unit diagonal), D on it
+  // With mimic joints: the chain's joint values, speeds, accelerations and torques.
+  JointVector chainQ, chainQd, chainQdd, chainTau;
   /// @endcond
 };
 

@@ -3,6 +3,7 @@
 /// The constant description of a serial manipulator: kinematics (Denavit-Hartenberg or general
 /// placements), dynamics, drive train and limits (paper section 3.3, Figure 7).
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -86,6 +87,16 @@ struct LinkParameters {
   std::string linkName;   ///< name of link i, the body joint i moves (unique); empty: `link1`, `link2`, ...
 };
 
+/// How joint k of a chain with mimic joints moves (ManipulatorModel::getCoupling()): an
+/// independent joint of the model, or a mimic joint that follows one,
+/// \f$q^{\mathrm{chain}}_k = \mathrm{multiplier}\,q_{\mathrm{joint}} + \mathrm{offset}\f$ (a URDF `<mimic>`).
+struct JointCoupling {
+  int joint = 0;          ///< the model's joint (from 0) that moves chain joint k
+  double multiplier = 1;  ///< chain joint value per unit of `joint` (1 for the independent joint itself)
+  double offset = 0;      ///< chain joint value at `joint` = 0 [rad or m] (0 for the independent joint itself)
+  bool mimic = false;     ///< true: a mimic joint, no joint of the model; false: model joint `joint` itself
+};
+
 /// The constant model of a serial manipulator with revolute and prismatic joints: Denavit-Hartenberg
 /// (standard or modified) or general-placement (DHConvention::Placement) kinematics, rigid-body
 /// dynamics, motor inertia, friction and limits, a base transform (the
@@ -110,6 +121,21 @@ class ManipulatorModel {
   ManipulatorModel(std::string name, std::vector<LinkParameters> links, const Transform& base = Transform::unit(),
                    const Transform& tool = Transform::unit(), const Vector<3>& gravity = standardGravity(),
                    DHConvention convention = DHConvention::Standard);
+  /// Creates a model of a chain whose mimic joints follow other joints (a URDF `<mimic>` on the
+  /// chain): the model's joints are the chain's independent joints, in chain order, and every
+  /// algorithm (kinematics, Jacobians, dynamics) works on the full chain at
+  /// \f$q^{\mathrm{chain}} = S q + o\f$ and maps back (\f$J S\f$, \f$S^T \tau\f$, \f$S^T M S\f$).
+  /// Joint i's LinkParameters are those of its chain joint, with the limits narrowed to what the
+  /// mimic joints that follow it allow (positions, speeds, accelerations, jerks), and the mimic
+  /// joints' friction and motor inertia reflected onto it (so frictionTorque() and
+  /// getArmatureInertia() include them exactly); its mass data is only that of its own chain link
+  /// (the algorithms use getChain()).
+  /// @param[in] chain     the full chain, every joint a joint of its own (without mimic joints)
+  /// @param[in] coupling  one entry per chain joint; the independent ones numbered 0, 1, ... in order
+  /// @throws std::invalid_argument for a null chain, a chain with mimic joints, a coupling of the wrong
+  ///         size or out of order, no independent joint, a multiplier or offset that is not finite,
+  ///         or limits of a mimic joint that leave its master no position
+  ManipulatorModel(std::shared_ptr<const ManipulatorModel> chain, std::vector<JointCoupling> coupling);
   virtual ~ManipulatorModel() = default;
   ManipulatorModel(const ManipulatorModel&) = default;             ///< copyable
   ManipulatorModel& operator=(const ManipulatorModel&) = delete;  ///< a model never changes
@@ -176,6 +202,22 @@ class ManipulatorModel {
   /// A good resting configuration (the model's home or ready pose) [rad]. Real-time safe: yes.
   const JointVector& getHomePosition() const { return home_; }
 
+  /// Whether the chain has mimic joints (made by the coupling constructor). Real-time safe: yes.
+  bool hasMimicJoints() const { return chain_ != nullptr; }
+  /// The full chain, mimic joints included as joints of their own; the model itself when it has
+  /// no mimic joints. Real-time safe: yes.
+  const ManipulatorModel& getChain() const { return chain_ ? *chain_ : *this; }
+  /// How each chain joint moves (empty without mimic joints). Real-time safe: yes.
+  const std::vector<JointCoupling>& getCoupling() const { return coupling_; }
+  /// The chain joint (from 0) of joint `i` (`i` itself without mimic joints). Real-time safe: yes.
+  int getChainIndex(int i) const { return chain_ ? chainIndex_[static_cast<std::size_t>(i)] : i; }
+  /// The chain's joint values for the model's: \f$q^{\mathrm{chain}} = S q + o\f$ (`offsets` false:
+  /// \f$S q\f$, for speeds and accelerations); `q` itself without mimic joints. Real-time safe: yes.
+  /// @param[in] q        the model's joint values (numberOfJoints)
+  /// @param[out] chainQ  the chain's (getChain().getNumberOfJoints())
+  /// @param[in] offsets  whether to add the mimic offsets
+  void toChain(const JointVector& q, JointVector& chainQ, bool offsets = true) const;
+
  protected:
   /// Sets the home configuration (derived models call it in their constructor).
   /// @param[in] q  home joint angles [rad]
@@ -189,6 +231,9 @@ class ManipulatorModel {
   DHConvention convention_;
   std::vector<Transform> placements_;
   JointVector qmin_, qmax_, vmax_, amax_, jmax_, taumax_, armature_, home_, cosAlpha_, sinAlpha_;
+  std::shared_ptr<const ManipulatorModel> chain_;  // with mimic joints only
+  std::vector<JointCoupling> coupling_;
+  std::vector<int> chainIndex_;
 };
 
 }  // namespace rp

@@ -61,7 +61,8 @@ bool isPhysicalInertia(const Matrix<3, 3>& inertia);
 /// as they are (an asymmetry of rounding size, 1e-12 of the largest element, is accepted).
 /// @param[in] model  the manipulator
 /// @return the corrected model and the list of corrections
-/// @throws std::invalid_argument naming the link for an inertia, mass or centre of mass that is
+/// @throws std::invalid_argument for a model with mimic joints (ManipulatorModel::hasMimicJoints()),
+///         and naming the link for an inertia, mass or centre of mass that is
 ///         not finite
 /// Real-time safe: no.
 PhysicalModel physicalModel(const ManipulatorModel& model);

@@ -41,7 +41,9 @@ struct UrdfOptions {
 
 /// Loads the serial chain from the URDF root link to a tip link as a ManipulatorModel.
 ///
-/// Revolute, continuous and prismatic joints become the model's joints, fixed joints are merged
+/// Revolute, continuous and prismatic joints become the model's joints (mimic joints on the chain
+/// follow their master and are no joints of the model: ManipulatorModel::getChain() and
+/// getCoupling()), fixed joints are merged
 /// into the links around them (their inertias combined about the common centre of mass), links
 /// moved by joints off the chain (fingers, a jaw) are lumped into the chain link they hang on at
 /// a stated configuration (UrdfOptions::offChainPositions; zero by default; mimic joints follow
@@ -66,7 +68,7 @@ struct UrdfOptions {
 ///         floating or planar joint in the chain, an unknown tip, a branching robot
 ///         without a tip, no movable joint, a number that is not finite (naming the joint or
 ///         link), a mimic joint naming a missing joint (or mimics in a circle), a mimic joint on
-///         the chain, and (with requireDynamics) a moving link without inertial data
+///         the chain following a joint off it, and (with requireDynamics) a moving link without inertial data
 /// Real-time safe: no.
 std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options = UrdfOptions());
 
