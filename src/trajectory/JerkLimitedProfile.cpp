@@ -47,6 +47,50 @@ JerkLimitedProfile::JerkLimitedProfile(double distance, double vmax, double amax
   vp_ = ap_ * (ta - tj);
 }
 
+JerkLimitedProfile JerkLimitedProfile::withDuration(double distance, double duration, double vmax, double amax,
+                                                    double jmax) {
+  JerkLimitedProfile p(distance, vmax, amax, jmax);
+  if (distance == 0) return p;
+  const double shortest = p.getDuration();
+  if (!(duration >= shortest * (1 - 1e-9)) || !std::isfinite(duration)) {
+    throw std::invalid_argument("JerkLimitedProfile: a duration of " + std::to_string(duration) +
+                                " s is shorter than the minimum " + std::to_string(shortest) + " s");
+  }
+  if (duration <= shortest) return p;
+  const double D = distance, T = duration, a = amax, j = jmax;
+  // The distance covered by the profile whose acceleration phase lasts ta (see the header).
+  auto covered = [&](double ta) {
+    const double tj = std::min(a / j, 0.5 * ta);
+    return j * tj * (ta - tj) * (T - ta);
+  };
+  double ta;
+  const double knee = 2 * a / j;  // shortest acceleration phase that reaches the acceleration limit
+  if (knee < 0.5 * T && covered(knee) < D) {
+    // tj = a / j: a (ta - a/j) (T - ta) = D, the smaller root of
+    // ta^2 - (T + a/j) ta + (a T / j + D / a) = 0.
+    const double b = T + a / j, c = a * T / j + D / a;
+    const double disc = std::max(0.0, b * b - 4 * c);
+    ta = 2 * c / (b + std::sqrt(disc));  // the smaller root, without cancellation
+  } else {
+    double lo = 0, hi = std::min(knee, 0.5 * T);
+    for (int i = 0; i < 200 && hi - lo > 1e-16 * T; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      if (covered(mid) < D) lo = mid;
+      else hi = mid;
+    }
+    ta = 0.5 * (lo + hi);
+  }
+  ta = std::clamp(ta, 0.0, 0.5 * T);
+  const double tj = std::min(a / j, 0.5 * ta);
+  p.tj_ = tj;
+  p.ta_ = ta;
+  p.tv_ = T - 2 * ta;
+  while (2 * ta + p.tv_ > T) p.tv_ = std::nextafter(p.tv_, 0.0);  // the end no later than T
+  p.ap_ = j * tj;
+  p.vp_ = p.ap_ * (ta - tj);
+  return p;
+}
+
 // The acceleration phase from rest: jerk +j for tj, constant acceleration, jerk -j for tj.
 ProfileState JerkLimitedProfile::accelerationPhase(double t) const {
   const double j = jerk_, tj = tj_, ta = ta_, ap = ap_;
@@ -75,7 +119,8 @@ ProfileState JerkLimitedProfile::accelerationPhase(double t) const {
 ProfileState JerkLimitedProfile::evaluate(double t) const {
   const double T = getDuration();
   if (distance_ == 0) return ProfileState{};
-  t = std::clamp(t, 0.0, T);
+  if (t >= T) return ProfileState{distance_, 0, 0};  // exactly at rest at the end
+  t = std::max(t, 0.0);
   if (t <= ta_) return accelerationPhase(t);
   if (t <= ta_ + tv_) {
     ProfileState s;

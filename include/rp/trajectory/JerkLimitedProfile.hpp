@@ -36,6 +36,26 @@ class JerkLimitedProfile {
   /// @param[in] jmax      jerk limit [units/s^3]
   /// @throws std::invalid_argument for a negative distance or non-positive limits
   JerkLimitedProfile(double distance, double vmax, double amax, double jmax);
+  /// Plans the rest-to-rest motion over `distance` that takes exactly `duration`, for time
+  /// synchronisation of several joints (Synchronization::Time).
+  ///
+  /// From rest to rest every duration at or above the minimum is reachable: the profile keeps the
+  /// seven-phase shape at the full jerk and lowers its cruise velocity. With \f$T_j = \min(a/j,
+  /// T_a/2)\f$ and \f$v_p = j T_j (T_a - T_j)\f$, the covered distance \f$v_p (T - T_a)\f$ grows
+  /// strictly with \f$T_a \in (0, T/2]\f$, so exactly one \f$T_a\f$ covers `distance` (closed form
+  /// when the acceleration limit is reached, bisection otherwise); the cruise lasts
+  /// \f$T - 2T_a\f$. The peak velocity and acceleration are no higher than the minimum-time
+  /// profile's, so no limit is exceeded.
+  /// @param[in] distance  length of the motion [units], >= 0
+  /// @param[in] duration  duration wanted [s], >= the minimum-time profile's (a duration below it
+  ///                      by at most 1e-9 relative is taken as the minimum)
+  /// @param[in] vmax      velocity limit [units/s], > 0
+  /// @param[in] amax      acceleration limit [units/s^2], > 0
+  /// @param[in] jmax      jerk limit [units/s^3], > 0
+  /// @return the profile; getDuration() equals `duration` (for a zero distance, 0: it stays at rest)
+  /// @throws std::invalid_argument for a duration shorter than the minimum, or bad limits
+  /// Real-time safe: yes, except for the exception (no allocation on success).
+  static JerkLimitedProfile withDuration(double distance, double duration, double vmax, double amax, double jmax);
 
   /// Duration of the motion [s]. Real-time safe: yes.
   double getDuration() const { return 2 * ta_ + tv_; }
