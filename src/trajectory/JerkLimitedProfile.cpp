@@ -57,37 +57,16 @@ JerkLimitedProfile JerkLimitedProfile::withDuration(double distance, double dura
                                 " s is shorter than the minimum " + std::to_string(shortest) + " s");
   }
   if (duration <= shortest) return p;
-  const double D = distance, T = duration, a = amax, j = jmax;
-  // The distance covered by the profile whose acceleration phase lasts ta (see the header).
-  auto covered = [&](double ta) {
-    const double tj = std::min(a / j, 0.5 * ta);
-    return j * tj * (ta - tj) * (T - ta);
-  };
-  double ta;
-  const double knee = 2 * a / j;  // shortest acceleration phase that reaches the acceleration limit
-  if (knee < 0.5 * T && covered(knee) < D) {
-    // tj = a / j: a (ta - a/j) (T - ta) = D, the smaller root of
-    // ta^2 - (T + a/j) ta + (a T / j + D / a) = 0.
-    const double b = T + a / j, c = a * T / j + D / a;
-    const double disc = std::max(0.0, b * b - 4 * c);
-    ta = 2 * c / (b + std::sqrt(disc));  // the smaller root, without cancellation
-  } else {
-    double lo = 0, hi = std::min(knee, 0.5 * T);
-    for (int i = 0; i < 200 && hi - lo > 1e-16 * T; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      if (covered(mid) < D) lo = mid;
-      else hi = mid;
-    }
-    ta = 0.5 * (lo + hi);
+  // The minimum-time profile slowed down by s = duration / shortest: the limits v / s, a / s^2,
+  // j / s^3 give the same case and every phase s times as long (see the header).
+  const double s = duration / shortest;
+  p = JerkLimitedProfile(distance, vmax / s, amax / (s * s), jmax / (s * s * s));
+  // Rounding may leave the end an ulp after `duration`: the end exactly at it or before.
+  if (p.tv_ > 0) p.tv_ = std::max(0.0, duration - 2 * p.ta_);
+  for (int i = 0; i < 64 && 2 * p.ta_ + p.tv_ > duration; ++i) {
+    if (p.tv_ > 0) p.tv_ = std::nextafter(p.tv_, 0.0);
+    else p.ta_ = std::nextafter(p.ta_, 0.0);
   }
-  ta = std::clamp(ta, 0.0, 0.5 * T);
-  const double tj = std::min(a / j, 0.5 * ta);
-  p.tj_ = tj;
-  p.ta_ = ta;
-  p.tv_ = T - 2 * ta;
-  while (2 * ta + p.tv_ > T) p.tv_ = std::nextafter(p.tv_, 0.0);  // the end no later than T
-  p.ap_ = j * tj;
-  p.vp_ = p.ap_ * (ta - tj);
   return p;
 }
 

@@ -39,13 +39,13 @@ class JerkLimitedProfile {
   /// Plans the rest-to-rest motion over `distance` that takes exactly `duration`, for time
   /// synchronisation of several joints (Synchronization::Time).
   ///
-  /// From rest to rest every duration at or above the minimum is reachable: the profile keeps the
-  /// seven-phase shape at the full jerk and lowers its cruise velocity. With \f$T_j = \min(a/j,
-  /// T_a/2)\f$ and \f$v_p = j T_j (T_a - T_j)\f$, the covered distance \f$v_p (T - T_a)\f$ grows
-  /// strictly with \f$T_a \in (0, T/2]\f$, so exactly one \f$T_a\f$ covers `distance` (closed form
-  /// when the acceleration limit is reached, bisection otherwise); the cruise lasts
-  /// \f$T - 2T_a\f$. The peak velocity and acceleration are no higher than the minimum-time
-  /// profile's, so no limit is exceeded.
+  /// From rest to rest every duration at or above the minimum is reachable: the minimum-time
+  /// profile slowed down by \f$s = T / T_{min} \ge 1\f$, which is the minimum-time profile under
+  /// the limits \f$v/s, a/s^2, j/s^3\f$ (the same case of the three, every phase \f$s\f$ times as
+  /// long). Its peak velocity, acceleration and jerk are the minimum-time profile's divided by
+  /// \f$s, s^2, s^3\f$: the joints that wait for the slowest one move as gently as they can in
+  /// the common time, rather than rushing at their limits and then cruising slowly, which also
+  /// leaves room to overlap two motions at a blend.
   /// @param[in] distance  length of the motion [units], >= 0
   /// @param[in] duration  duration wanted [s], >= the minimum-time profile's (a duration below it
   ///                      by at most 1e-9 relative is taken as the minimum)
