@@ -116,6 +116,18 @@ ProfileState JerkLimitedProfile::evaluate(double t) const {
   return s;
 }
 
+double JerkLimitedProfile::jerkAt(double t) const {
+  const double T = getDuration();
+  if (distance_ == 0 || !(t >= 0) || t >= T) return 0;
+  if (t < tj_) return jerk_;
+  if (t < ta_ - tj_) return 0;
+  if (t < ta_) return -jerk_;
+  if (t < T - ta_) return 0;
+  if (t < T - ta_ + tj_) return -jerk_;
+  if (t < T - tj_) return 0;
+  return jerk_;
+}
+
 double JerkLimitedProfile::timeAtPosition(double position) const {
   if (distance_ == 0 || position <= 0) return 0;
   if (position >= distance_) return getDuration();

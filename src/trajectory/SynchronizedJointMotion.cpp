@@ -99,6 +99,14 @@ void SynchronizedJointMotion::evaluate(double t, Setpoint& setpoint) const {
   }
 }
 
+double SynchronizedJointMotion::jointJerk(int joint, double t) const {
+  const double d = delta_(joint);
+  if (mode_ == Synchronization::Phase) return d * line_.jerkAt(t);
+  if (t >= getJointDuration(joint)) return 0;
+  const double j = profiles_[static_cast<std::size_t>(joint)].jerkAt(t);
+  return d < 0 ? -j : j;
+}
+
 int SynchronizedJointMotion::getJointBreakpoints(int joint, double times[6]) const {
   if (delta_(joint) == 0) return 0;
   if (mode_ == Synchronization::Phase) return line_.getBreakpoints(times);

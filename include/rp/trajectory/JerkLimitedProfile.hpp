@@ -65,6 +65,9 @@ class JerkLimitedProfile {
   double getPeakAcceleration() const { return ap_; }
   /// The state at time `t` (clamped to [0, duration]). Real-time safe: yes.
   ProfileState evaluate(double t) const;
+  /// The jerk at time `t` [units/s^3]: +j, 0 or -j by phase (at a switching instant, the phase
+  /// that begins there; 0 outside (0, duration)). Real-time safe: yes.
+  double jerkAt(double t) const;
   /// The time at which the motion has covered `position` (clamped to [0, distance]); the
   /// position grows strictly while the motion lasts, so the answer is unique.
   /// @param[in] position  distance covered [units]

@@ -64,6 +64,10 @@ class SynchronizedJointMotion {
   /// @param[in] t      time since the start [s]
   /// Real-time safe: yes.
   ProfileState evaluateJoint(int joint, double t) const;
+  /// One joint's jerk at time `t` [rad/s^3] (see JerkLimitedProfile::jerkAt()).
+  /// @param[in] joint  index, 0 <= joint < n
+  /// @param[in] t      time since the start [s]
+  double jointJerk(int joint, double t) const;
   /// The instants inside (0, duration) where joint `joint`'s jerk changes (at most six), in
   /// increasing order; between two of them its position is a cubic in time.
   /// @param[in]  joint  index, 0 <= joint < n
