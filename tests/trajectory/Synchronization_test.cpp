@@ -163,6 +163,14 @@ TEST(JerkLimitedProfile, WithDurationTakesExactlyThatDurationWithinTheLimits) {
       ASSERT_LE(std::abs(s.position - prev.position), v * dt * (1 + 1e-6) + 1e-12 * D);
       prev = s;
     }
+    // jerkAt(): the slope of the acceleration between samples that share a phase.
+    for (int i = 0; i < 20; ++i) {
+      const double t = T * (i + 0.5) / 20, h = 1e-7 * T;
+      if (p.jerkAt(t - h) != p.jerkAt(t + h)) continue;  // a switch in between
+      const double slope = (p.evaluate(t + h).acceleration - p.evaluate(t - h).acceleration) / (2 * h);
+      ASSERT_NEAR(slope, p.jerkAt(t), 1e-5 * j) << "t=" << t << " of " << T;
+      ASSERT_LE(std::abs(p.jerkAt(t)), j);
+    }
     const ProfileState end = p.evaluate(T);
     ASSERT_EQ(end.position, D);
     ASSERT_EQ(end.velocity, 0.0);

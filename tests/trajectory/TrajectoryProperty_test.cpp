@@ -125,7 +125,7 @@ TEST(TrajectoryProperty, RandomSequencesWithAndWithoutBlends) {
   }
   // Nearly every via point of a blended sequence is blended. A via point is passed at rest only
   // when neither overlapping the two motions nor a quintic at most three times as long as stopping
-  // keeps the limits (0.6 % of these random via points).
+  // keeps the limits (0.7 % of these random via points, the joints synchronised in time).
   EXPECT_GT(blends, vias * 98 / 100);
   RecordProperty("sequences", sequences);
   RecordProperty("segments", static_cast<int>(segments));
