@@ -60,7 +60,21 @@ JerkLimitedProfile JerkLimitedProfile::withDuration(double distance, double dura
   // The minimum-time profile slowed down by s = duration / shortest: the limits v / s, a / s^2,
   // j / s^3 give the same case and every phase s times as long (see the header).
   const double s = duration / shortest;
-  p = JerkLimitedProfile(distance, vmax / s, amax / (s * s), jmax / (s * s * s));
+  const double js = jmax / (s * s * s);
+  if (!(js > 0) || !(amax / (s * s) > 0)) {
+    // A distance so short against the duration that s^3 overflows: the profile that reaches
+    // neither limit (the minimum-time case of such a distance), four jerk phases of T / 4 each
+    // with the jerk that covers the distance, D = 2 j tj^3.
+    const double tj = 0.25 * duration;
+    p.tj_ = tj;
+    p.ta_ = 2 * tj;
+    p.tv_ = 0;
+    p.jerk_ = distance / (2 * tj * tj * tj);
+    p.ap_ = p.jerk_ * tj;
+    p.vp_ = p.ap_ * tj;
+    return p;
+  }
+  p = JerkLimitedProfile(distance, vmax / s, amax / (s * s), js);
   // Rounding may leave the end an ulp after `duration`: the end exactly at it or before.
   if (p.tv_ > 0) p.tv_ = std::max(0.0, duration - 2 * p.ta_);
   for (int i = 0; i < 64 && 2 * p.ta_ + p.tv_ > duration; ++i) {

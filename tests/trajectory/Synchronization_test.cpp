@@ -179,6 +179,17 @@ TEST(JerkLimitedProfile, WithDurationTakesExactlyThatDurationWithinTheLimits) {
   EXPECT_THROW(JerkLimitedProfile::withDuration(1, 0.5 * JerkLimitedProfile(1, 1, 1, 1).getDuration(), 1, 1, 1),
                std::invalid_argument);
   EXPECT_EQ(JerkLimitedProfile::withDuration(0, 3, 1, 1, 1).getDuration(), 0.0);
+  // Tiny distances over long durations (the slowdown's cube overflows): still exactly the
+  // duration, within the limits, exactly at the end.
+  for (double D : {1e-300, 1e-310, 1e-12}) {
+    const JerkLimitedProfile p = JerkLimitedProfile::withDuration(D, 10, 1, 1, 1);
+    EXPECT_EQ(p.getDuration(), 10.0) << D;
+    EXPECT_LE(p.getPeakVelocity(), 1.0);
+    EXPECT_LE(p.getPeakAcceleration(), 1.0);
+    EXPECT_EQ(p.evaluate(10).position, D);
+    EXPECT_GE(p.evaluate(5).position, 0.0);
+    EXPECT_LE(p.evaluate(5).position, D);
+  }
 }
 
 TEST(Synchronization, TimeIsNeverLongerThanABruteForceSearchOverDurations) {
