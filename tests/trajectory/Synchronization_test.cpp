@@ -282,6 +282,7 @@ TEST(Synchronization, TheGeneratorDefaultsToTimeAndOffersPhaseAndNone) {
   for (int m = 0; m < 3; ++m) {
     OfflinePlanner planner(wam, start);
     EXPECT_EQ(planner.generator().getSynchronization(), Synchronization::Time) << "the default";
+    EXPECT_THROW(planner.generator().setSynchronization(static_cast<Synchronization>(7)), std::invalid_argument);
     planner.generator().setSpeedFraction(1);
     planner.generator().setJointLimits(v, a, j);
     planner.generator().setSynchronization(modes[m]);
