@@ -32,6 +32,7 @@
 #include "CartesianPath.hpp"
 #include "Segment.hpp"
 #include "rp/RoboticPlatform.hpp"
+#include "rp/trajectory/JointLineSegment.hpp"
 
 namespace {
 

@@ -4,6 +4,9 @@
 #include <pybind11/pybind11.h>
 
 #include <memory>
+#include <string>
+
+#include "rp/trajectory/Synchronization.hpp"
 
 namespace rp {
 class ManipulatorModel;
@@ -22,6 +25,9 @@ void bindPlatform(pybind11::module_& m);
 void bindTrajectories(pybind11::module_& m);
 /// The model of a Python Model object (Models.cpp); a TypeError for anything else.
 const ManipulatorModel& modelOf(const pybind11::handle& object);
+/// The synchronisation mode named "time", "phase" or "none" (Trajectories.cpp); a ValueError
+/// naming the three for anything else.
+Synchronization synchronizationOf(const std::string& name);
 /// The same model, shared (the Python object may go before whoever keeps it).
 std::shared_ptr<const ManipulatorModel> sharedModelOf(const pybind11::handle& object);
 

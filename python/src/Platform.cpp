@@ -178,6 +178,11 @@ void bindPlatform(py::module_& m) {
            py::call_guard<py::gil_scoped_release>())
       .def("set_joint_blend_radius", &Generator::setJointBlendRadius, py::arg("radians"),
            py::call_guard<py::gil_scoped_release>())
+      .def("set_synchronization", [](Generator& g, const std::string& mode) {
+             const Synchronization s = synchronizationOf(mode);
+             py::gil_scoped_release release;
+             g.setSynchronization(s);
+           }, py::arg("mode"), "'time' (the default), 'phase' or 'none' (see Planner.set_synchronization)")
       .def("set_cartesian_blend_radius", &Generator::setCartesianBlendRadius, py::arg("metres"),
            py::call_guard<py::gil_scoped_release>())
       .def_property_readonly("blend_count", [](const Generator& g) {

@@ -14,6 +14,13 @@
 
 namespace rp::python {
 
+Synchronization synchronizationOf(const std::string& name) {
+  if (name == "time") return Synchronization::Time;
+  if (name == "phase") return Synchronization::Phase;
+  if (name == "none") return Synchronization::None;
+  throw py::value_error("synchronization: '" + name + "' is not one of time, phase, none");
+}
+
 void bindTrajectories(py::module_& m) {
   m.def(
       "plan_joint_motion",
@@ -107,6 +114,11 @@ void bindTrajectories(py::module_& m) {
            py::arg("metres"))
       .def("set_speed_fraction", [](OfflinePlanner& p, double f) { p.generator().setSpeedFraction(f); },
            py::arg("fraction"))
+      .def("set_synchronization",
+           [](OfflinePlanner& p, const std::string& mode) { p.generator().setSynchronization(synchronizationOf(mode)); },
+           py::arg("mode"),
+           "how the joints of the joint motions queued from now on are synchronised: 'time' (the default: all end "
+           "together at the slowest joint's minimum time), 'phase' (the straight line in joint space) or 'none'")
       .def(
           "sample",
           [](OfflinePlanner& p, double rate) {

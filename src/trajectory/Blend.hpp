@@ -11,9 +11,9 @@ namespace rp::internal {
 // and acceleration at either end of the overlap, and it saves exactly `overlap` seconds.
 // The overlap is the longest (found by a scan, then bisection) that
 // - begins no earlier than from.exitTime and ends no later than to.entryTime (the blend radius),
-// - keeps every joint within its velocity, acceleration and jerk limits. For two joint-space
-//   lines this is checked exactly: between the instants where either profile's jerk changes,
-//   each joint's position is a cubic, so the velocity peaks at a piece's ends or where the
+// - keeps every joint within its velocity, acceleration and jerk limits. For two joint motions
+//   (any Synchronization) this is checked exactly, joint by joint: between the instants where
+//   the joint's jerk changes in either motion, its position is a cubic, so the velocity peaks at a piece's ends or where the
 //   (linear) acceleration crosses zero, the acceleration at the ends, and the jerk is constant.
 //   With a Cartesian path in the pair, it is checked at 2,000 samples against 98 % of the limits.
 // If no overlap of at least a millisecond keeps the limits (two motions that each drive some

@@ -47,6 +47,43 @@ JerkLimitedProfile::JerkLimitedProfile(double distance, double vmax, double amax
   vp_ = ap_ * (ta - tj);
 }
 
+JerkLimitedProfile JerkLimitedProfile::withDuration(double distance, double duration, double vmax, double amax,
+                                                    double jmax) {
+  JerkLimitedProfile p(distance, vmax, amax, jmax);
+  if (distance == 0) return p;
+  const double shortest = p.getDuration();
+  if (!(duration >= shortest * (1 - 1e-9)) || !std::isfinite(duration)) {
+    throw std::invalid_argument("JerkLimitedProfile: a duration of " + std::to_string(duration) +
+                                " s is shorter than the minimum " + std::to_string(shortest) + " s");
+  }
+  if (duration <= shortest) return p;
+  // The minimum-time profile slowed down by s = duration / shortest: the limits v / s, a / s^2,
+  // j / s^3 give the same case and every phase s times as long (see the header).
+  const double s = duration / shortest;
+  const double js = jmax / (s * s * s);
+  if (!(js > 0) || !(amax / (s * s) > 0)) {
+    // A distance so short against the duration that s^3 overflows: the profile that reaches
+    // neither limit (the minimum-time case of such a distance), four jerk phases of T / 4 each
+    // with the jerk that covers the distance, D = 2 j tj^3.
+    const double tj = 0.25 * duration;
+    p.tj_ = tj;
+    p.ta_ = 2 * tj;
+    p.tv_ = 0;
+    p.jerk_ = distance / (2 * tj * tj * tj);
+    p.ap_ = p.jerk_ * tj;
+    p.vp_ = p.ap_ * tj;
+    return p;
+  }
+  p = JerkLimitedProfile(distance, vmax / s, amax / (s * s), js);
+  // Rounding may leave the end an ulp after `duration`: the end exactly at it or before.
+  if (p.tv_ > 0) p.tv_ = std::max(0.0, duration - 2 * p.ta_);
+  for (int i = 0; i < 64 && 2 * p.ta_ + p.tv_ > duration; ++i) {
+    if (p.tv_ > 0) p.tv_ = std::nextafter(p.tv_, 0.0);
+    else p.ta_ = std::nextafter(p.ta_, 0.0);
+  }
+  return p;
+}
+
 // The acceleration phase from rest: jerk +j for tj, constant acceleration, jerk -j for tj.
 ProfileState JerkLimitedProfile::accelerationPhase(double t) const {
   const double j = jerk_, tj = tj_, ta = ta_, ap = ap_;
@@ -75,7 +112,8 @@ ProfileState JerkLimitedProfile::accelerationPhase(double t) const {
 ProfileState JerkLimitedProfile::evaluate(double t) const {
   const double T = getDuration();
   if (distance_ == 0) return ProfileState{};
-  t = std::clamp(t, 0.0, T);
+  if (t >= T) return ProfileState{distance_, 0, 0};  // exactly at rest at the end
+  t = std::max(t, 0.0);
   if (t <= ta_) return accelerationPhase(t);
   if (t <= ta_ + tv_) {
     ProfileState s;
@@ -90,6 +128,18 @@ ProfileState JerkLimitedProfile::evaluate(double t) const {
   s.velocity = m.velocity;
   s.acceleration = -m.acceleration;
   return s;
+}
+
+double JerkLimitedProfile::jerkAt(double t) const {
+  const double T = getDuration();
+  if (distance_ == 0 || !(t >= 0) || t >= T) return 0;
+  if (t < tj_) return jerk_;
+  if (t < ta_ - tj_) return 0;
+  if (t < ta_) return -jerk_;
+  if (t < T - ta_) return 0;
+  if (t < T - ta_ + tj_) return -jerk_;
+  if (t < T - tj_) return 0;
+  return jerk_;
 }
 
 double JerkLimitedProfile::timeAtPosition(double position) const {

@@ -109,14 +109,17 @@ void QueueTrajectoryGenerator::queueJointMotion(const JointVector& target) {
   const Limits l = planningLimits(model);
   internal::SegmentPlan plan;
   plan.kind = internal::SegmentKind::Line;
-  plan.line = JointLineSegment(start, target, l.velocity, l.acceleration, l.jerk);
+  plan.line = SynchronizedJointMotion(start, target, l.velocity, l.acceleration, l.jerk, getSynchronization());
   plan.duration = plan.line.getDuration();
   plan.end = target;
   plan.exitTime = plan.duration;
   const double radius = getJointBlendRadius(), distance = (target - start).norm();
   if (radius > 0 && distance > 0) {
-    plan.exitTime = plan.timeAtFraction(std::max(0.5, 1 - radius / distance));
-    plan.entryTime = plan.timeAtFraction(std::min(0.5, radius / distance));
+    // Within the radius of either end, at most half-way (for a straight line: the fractions
+    // 1 - radius / distance and radius / distance, each capped at 0.5).
+    const double r = std::min(radius, 0.5 * distance);
+    plan.exitTime = plan.line.timeWithinOfTarget(r);
+    plan.entryTime = plan.line.timeWithinOfStart(r);
   }
   pushPlanned(std::move(plan));
 }
@@ -284,6 +287,19 @@ void QueueTrajectoryGenerator::setRadius(double& radius, double value, const cha
 double QueueTrajectoryGenerator::getCartesianBlendRadius() const {
   std::lock_guard<std::mutex> lock(producerMutex_);
   return cartesianBlendRadius_;
+}
+
+void QueueTrajectoryGenerator::setSynchronization(Synchronization mode) {
+  if (mode != Synchronization::Time && mode != Synchronization::Phase && mode != Synchronization::None) {
+    throw std::invalid_argument(getName() + ": unknown synchronisation mode " + std::to_string(static_cast<int>(mode)));
+  }
+  std::lock_guard<std::mutex> lock(producerMutex_);
+  synchronization_ = mode;
+}
+
+Synchronization QueueTrajectoryGenerator::getSynchronization() const {
+  std::lock_guard<std::mutex> lock(producerMutex_);
+  return synchronization_;
 }
 
 int QueueTrajectoryGenerator::getBlendCount() const {

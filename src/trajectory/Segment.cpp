@@ -74,7 +74,7 @@ void SegmentPlan::evaluate(double t, Setpoint& out) const {
 }
 
 double SegmentPlan::timeAtFraction(double s) const {
-  if (kind == SegmentKind::Line) return line.getProfile().timeAtPosition(s);
+  if (kind == SegmentKind::Line) return line.timeWithinOfStart(s * line.getDelta().norm());
   if (kind == SegmentKind::Path) return profile.timeAtPosition(s);
   return s * duration;
 }

@@ -4,7 +4,7 @@
 #include <array>
 #include <vector>
 
-#include "rp/trajectory/JointLineSegment.hpp"
+#include "rp/trajectory/SynchronizedJointMotion.hpp"
 
 namespace rp::internal {
 
@@ -28,7 +28,7 @@ enum class SegmentKind { Line, Dwell, Blend, Path };
 // One queued motion. Local time runs from 0 to `duration`.
 struct SegmentPlan {
   SegmentKind kind = SegmentKind::Dwell;
-  JointLineSegment line;                    // Line
+  SynchronizedJointMotion line;             // Line (a joint motion in any Synchronization)
   JointVector hold;                         // Dwell: the position held
   // Blend, either the two motions overlapped, q(t) = from(fromStart + t) + to(t) - from.end for
   // t in [0, duration] (`from` set), or a quintic per joint, q(t) = sum c_m t^m (`from` null,
@@ -51,7 +51,8 @@ struct SegmentPlan {
 
   // The setpoint at local time t (clamped). Real-time safe.
   void evaluate(double t, Setpoint& out) const;
-  // Position at the path fraction s (Line and Path only), for planning.
+  // The time at the path fraction s (Path: of the path parameter; Line: of the Euclidean
+  // distance in joint space from the start, the last time the arm is that close to it), for planning.
   double timeAtFraction(double s) const;
 };
 

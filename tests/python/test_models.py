@@ -270,3 +270,39 @@ def test_the_planner_samples_the_generators_cartesian_and_blended_motions():
     assert via_plan(0.1)["duration"] < via_plan(0.0)["duration"] - 0.05
     with pytest.raises(ValueError, match="outside the limits"):
         rp.Planner(puma).move_radians(puma.home + [0, 1, 0, 0, 0, 0])
+
+
+def test_the_planner_synchronises_joints_in_time_by_default_and_offers_phase_and_none():
+    # Issue 17: 'time' (the default) ends all joints together at the slowest joint's own minimum
+    # time, each joint on its own profile; 'phase' keeps the straight line in joint space; 'none'
+    # lets each joint arrive on its own time. The Puma's limits are in the same ratio on every
+    # joint, so here the straight line is as short (rp-plan's and the C++ tests cover limits
+    # that differ per joint).
+    puma = rp.Puma560Model()
+    start = puma.home.copy()
+    target = start + np.array([1.0, -0.4, 0.3, 1.2, -0.8, 0.5])
+    runs = {}
+    for mode in (None, "time", "phase", "none"):
+        p = rp.Planner(puma, start)
+        if mode is not None:
+            p.set_synchronization(mode)
+        p.move_radians(target)
+        runs[mode] = p.sample(1000)
+    assert runs[None]["duration"] == runs["time"]["duration"]
+    assert runs["phase"]["duration"] == pytest.approx(runs["time"]["duration"], abs=1e-9)
+    assert runs["none"]["duration"] == pytest.approx(runs["time"]["duration"], abs=1e-9)
+
+    def off_line(q):
+        along = (q[:, 0] - start[0]) / (target[0] - start[0])
+        return np.abs(q - start - np.outer(along, target - start)).max()
+
+    assert off_line(runs["phase"]["q"]) < 1e-9, "phase: a straight line"
+    assert off_line(runs["time"]["q"]) > 1e-3, "time: each joint on its own profile"
+    # Without synchronisation joint 2 (the shortest motion) arrives long before the end.
+    q = runs["none"]["q"]
+    arrived = np.flatnonzero(np.abs(q[:, 1] - target[1]) < 1e-12)[0]
+    assert arrived < 0.8 * len(q)
+    for s in runs.values():
+        np.testing.assert_allclose(s["q"][-1], target, atol=1e-12)
+    with pytest.raises(ValueError, match="time, phase, none"):
+        rp.Planner(puma).set_synchronization("fast")

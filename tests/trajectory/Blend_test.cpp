@@ -63,7 +63,7 @@ SegmentPlan line(const JointVector& from, const JointVector& to, const JointVect
                  const JointVector& j, double radius) {
   SegmentPlan p;
   p.kind = SegmentKind::Line;
-  p.line = JointLineSegment(from, to, v, a, j);
+  p.line = SynchronizedJointMotion(from, to, v, a, j, Synchronization::Phase);
   p.duration = p.line.getDuration();
   p.end = to;
   const double d = (to - from).norm();

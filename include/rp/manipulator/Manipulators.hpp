@@ -14,4 +14,6 @@
 #include "rp/trajectory/JerkLimitedProfile.hpp"
 #include "rp/trajectory/OfflinePlanner.hpp"
 #include "rp/trajectory/QueueTrajectoryGenerator.hpp"
+#include "rp/trajectory/SynchronizedJointMotion.hpp"
+#include "rp/trajectory/Synchronization.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"

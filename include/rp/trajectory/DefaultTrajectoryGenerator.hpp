@@ -17,9 +17,11 @@ namespace rp {
 /// Queues motions to joint targets (move(), in degrees as the paper's Figure 23 writes them) and
 /// to end-effector poses (moveTo(), a Transform in metres as in Figure 21).
 ///
-/// move() is a synchronised straight line in joint space: all joints start and finish together,
-/// following one time-optimal jerk-limited profile under the tightest of the joints' velocity,
-/// acceleration and jerk limits (the model's, or setJointLimits()). moveTo() is a straight line
+/// move() is a jerk-limited joint motion within each joint's velocity, acceleration and jerk
+/// limits (the model's, or setJointLimits()); by default (Synchronization::Time) all joints start
+/// and finish together at the slowest joint's minimum time, each on its own profile;
+/// setSynchronization() offers the straight line in joint space (Synchronization::Phase) and
+/// unsynchronised joints (Synchronization::None). moveTo() is a straight line
 /// of the end-effector with the shortest-arc rotation, its joints found by inverse kinematics that
 /// follows the arm's configuration (IK branch) from the previous target. Arms with fewer than six
 /// joints, which cannot follow an arbitrary line, and arms that start from a singular
@@ -77,7 +79,7 @@ class DefaultTrajectoryGenerator : public QueueTrajectoryGenerator {
   /// see the class description.
   /// @throws std::invalid_argument if the arm cannot get there along the line within its limits
   void moveTo(const Transform& pose) { queuePose(pose); }
-  /// Queues a joint-space motion (a straight line in joint space, see move()) to the inverse
+  /// Queues a joint-space motion (synchronised as move() is) to the inverse
   /// kinematics solution of `pose` on the previous target's configuration.
   /// @throws std::invalid_argument if the inverse kinematics finds no solution within the limits
   void moveToThroughJointSpace(const Transform& pose) { queueJointMotion(solvePose(pose)); }

@@ -36,6 +36,26 @@ class JerkLimitedProfile {
   /// @param[in] jmax      jerk limit [units/s^3]
   /// @throws std::invalid_argument for a negative distance or non-positive limits
   JerkLimitedProfile(double distance, double vmax, double amax, double jmax);
+  /// Plans the rest-to-rest motion over `distance` that takes exactly `duration`, for time
+  /// synchronisation of several joints (Synchronization::Time).
+  ///
+  /// From rest to rest every duration at or above the minimum is reachable: the minimum-time
+  /// profile slowed down by \f$s = T / T_{min} \ge 1\f$, which is the minimum-time profile under
+  /// the limits \f$v/s, a/s^2, j/s^3\f$ (the same case of the three, every phase \f$s\f$ times as
+  /// long). Its peak velocity, acceleration and jerk are the minimum-time profile's divided by
+  /// \f$s, s^2, s^3\f$: the joints that wait for the slowest one move as gently as they can in
+  /// the common time, rather than rushing at their limits and then cruising slowly, which also
+  /// leaves room to overlap two motions at a blend.
+  /// @param[in] distance  length of the motion [units], >= 0
+  /// @param[in] duration  duration wanted [s], >= the minimum-time profile's (a duration below it
+  ///                      by at most 1e-9 relative is taken as the minimum)
+  /// @param[in] vmax      velocity limit [units/s], > 0
+  /// @param[in] amax      acceleration limit [units/s^2], > 0
+  /// @param[in] jmax      jerk limit [units/s^3], > 0
+  /// @return the profile; getDuration() equals `duration` (for a zero distance, 0: it stays at rest)
+  /// @throws std::invalid_argument for a duration shorter than the minimum, or bad limits
+  /// Real-time safe: yes, except for the exception (no allocation on success).
+  static JerkLimitedProfile withDuration(double distance, double duration, double vmax, double amax, double jmax);
 
   /// Duration of the motion [s]. Real-time safe: yes.
   double getDuration() const { return 2 * ta_ + tv_; }
@@ -45,6 +65,9 @@ class JerkLimitedProfile {
   double getPeakAcceleration() const { return ap_; }
   /// The state at time `t` (clamped to [0, duration]). Real-time safe: yes.
   ProfileState evaluate(double t) const;
+  /// The jerk at time `t` [units/s^3]: +j, 0 or -j by phase (at a switching instant, the phase
+  /// that begins there; 0 outside (0, duration)). Real-time safe: yes.
+  double jerkAt(double t) const;
   /// The time at which the motion has covered `position` (clamped to [0, distance]); the
   /// position grows strictly while the motion lasts, so the answer is unique.
   /// @param[in] position  distance covered [units]

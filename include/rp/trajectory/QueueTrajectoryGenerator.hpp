@@ -11,6 +11,7 @@
 #include "rp/math/Transform.hpp"
 #include "rp/trajectory/CartesianLimits.hpp"
 #include "rp/trajectory/JerkLimitedProfile.hpp"
+#include "rp/trajectory/Synchronization.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
 
 namespace rp {
@@ -108,6 +109,17 @@ class QueueTrajectoryGenerator : public TrajectoryGenerator {
   void setCartesianBlendRadius(double metres);
   /// The blend radius of Cartesian motions [m].
   double getCartesianBlendRadius() const;
+  /// Sets how the joints of joint motions queued from now on are synchronised (see
+  /// Synchronization and SynchronizedJointMotion): Synchronization::Time (the default) ends all
+  /// joints together at the shortest common duration, each on its own jerk-limited profile;
+  /// Synchronization::Phase keeps the straight line in joint space (up to about 10 % longer with
+  /// limits that differ per joint); Synchronization::None moves each joint on its own minimum
+  /// time. Cartesian motions (moveTo()) are not affected.
+  /// @param[in] mode  the synchronisation mode
+  /// @throws std::invalid_argument for a value that is no Synchronization
+  void setSynchronization(Synchronization mode);
+  /// How the joints of joint motions are synchronised.
+  Synchronization getSynchronization() const;
   /// The target the last queued segment ends at (n x 1) [rad].
   /// @throws std::logic_error if no manipulator is connected
   JointVector getLastTarget() const;
@@ -115,8 +127,9 @@ class QueueTrajectoryGenerator : public TrajectoryGenerator {
   int getBlendCount() const;
 
  protected:
-  /// Queues a synchronised straight-line joint motion from the last target to `target` under
-  /// the joint velocity, acceleration and jerk limits (see JointLineSegment).
+  /// Queues a joint motion from the last target to `target` under the joint velocity,
+  /// acceleration and jerk limits, its joints synchronised as setSynchronization() says (see
+  /// SynchronizedJointMotion).
   /// @param[in] target  joint positions (n x 1) [rad]
   /// @throws std::invalid_argument if `target` has the wrong size or lies outside the joint limits
   void queueJointMotion(const JointVector& target);
@@ -156,6 +169,7 @@ class QueueTrajectoryGenerator : public TrajectoryGenerator {
   int blends_ = 0;
   double speedFraction_ = 0.8;
   double jointBlendRadius_ = 0, cartesianBlendRadius_ = 0;
+  Synchronization synchronization_ = Synchronization::Time;
   CartesianLimits cartesianLimits_;
   JointVector userVelocity_, userAcceleration_, userJerk_;  // empty: the model's
 };
