@@ -1,5 +1,6 @@
-// rp-objects: creates every object rp.cfg describes, prints name, class and settings, shuts them
-// down and exits 0; on a configuration error prints FILE:LINE: message and exits 2.
+// rp-objects: creates every object rp.cfg describes (and one unnamed object of the class of each
+// class section, such as [Puma560]), prints name, class and settings, shuts them down and exits 0;
+// on a configuration error prints FILE:LINE: message and exits 2.
 // rp-objects --settings [CLASS]: prints the settings reference of every registered class (or of
 // CLASS) from the classes' own setting schemas, as Markdown (docs/settings.md holds the same).
 #include <cstdio>
@@ -40,12 +41,15 @@ int main(int argc, char** argv) {
   std::vector<rp::RoboticObject*> objects;
   try {
     objects = om.createAllObjects();
+    // A class section configures the objects of its class without a section of their own: one
+    // unnamed object of the class checks it.
+    for (const auto& section : rp::RoboticPlatform::getConfiguration().sections())
+      if (section.isClassSection()) objects.push_back(om.createClassObject(section.className()));
   } catch (const std::exception& e) {
     std::cerr << e.what() << "\n";
     om.deleteAllObjects();
     return 2;
   }
-  const rp::Configuration& cfg = rp::RoboticPlatform::getConfiguration();
   std::size_t nameWidth = 4, classWidth = 5;
   for (auto* o : objects) {
     nameWidth = std::max(nameWidth, o->getName().size());
@@ -55,9 +59,10 @@ int main(int argc, char** argv) {
               "settings");
   for (auto* o : objects) {
     std::string settings;
-    if (const rp::ConfigSection* s = cfg.findSection(o->getName())) {
+    if (const rp::ConfigSection* s = o->configSection()) {
+      if (s->name() != o->getName()) settings = "[" + s->name() + "]";
       for (const auto& setting : s->settings()) {
-        if (!settings.empty()) settings += "; ";
+        if (!settings.empty()) settings += settings.back() == ']' ? " " : "; ";
         settings += setting.name;
         for (const auto& v : setting.values) settings += " " + v;
       }

@@ -571,6 +571,11 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
       if (!type)
         throw ConfigError(fileName, section.classLine_,
                           "class '" + ex(section.className_) + "' is not known (known: " + db.knownNames() + ")");
+      if (section.name_ != section.className_ && db.contains(section.name_))
+        throw ConfigError(fileName, section.classLine_,
+                          "section [" + section.name_ + "] is named after a class: it configures the " + section.name_ +
+                              " objects without a section of their own, so its class must be " + section.name_ +
+                              ", not " + ex(section.className_));
       for (const auto& s : section.settings_) {
         if (s.name == "qmotorConfig") continue;
         const SettingSpec* spec = type->schema.find(s.name);
@@ -589,6 +594,11 @@ const ConfigSection* Configuration::findSection(const std::string& name) const {
   for (const auto& s : sections_)
     if (s.name() == name) return &s;
   return nullptr;
+}
+
+const ConfigSection* Configuration::findClassSection(const std::string& className) const {
+  const ConfigSection* section = findSection(className);
+  return section != nullptr && section->isClassSection() ? section : nullptr;
 }
 
 std::string Configuration::sectionNames() const {

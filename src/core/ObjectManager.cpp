@@ -153,7 +153,7 @@ const TypeInfo& ObjectManager::checkedClass(const std::string& name, const std::
 RoboticObject* ObjectManager::create(const TypeInfo& info, const std::string& name) {
   std::unique_ptr<RoboticObject> object(info.create(name));
   RoboticObject* raw = object.get();
-  raw->publishObject();  // the most-derived constructor has returned
+  raw->startControlLoop();  // the most-derived constructor has returned: start its threads, publish it
   auto& reg = internal::registry();
   std::lock_guard<std::recursive_mutex> lock(reg.mutex);
   reg.owned.push_back(std::move(object));
@@ -163,8 +163,16 @@ RoboticObject* ObjectManager::create(const TypeInfo& info, const std::string& na
 std::vector<RoboticObject*> ObjectManager::createAllObjects() {
   std::vector<RoboticObject*> out;
   auto cfg = internal::currentConfiguration();
-  for (const auto& section : cfg->sections()) out.push_back(createObject(section.name()));
+  for (const auto& section : cfg->sections())
+    if (!section.isClassSection()) out.push_back(createObject(section.name()));
   return out;
+}
+
+RoboticObject* ObjectManager::createClassObject(const std::string& className) {
+  const TypeInfo* info = TypeDatabase::instance().find(className);
+  if (!info)
+    throw ObjectError("class '" + className + "' is not known (known: " + TypeDatabase::instance().knownNames() + ")");
+  return create(*info, "");
 }
 
 void ObjectManager::deleteObject(RoboticObject* object) {

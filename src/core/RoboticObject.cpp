@@ -2,8 +2,11 @@
 #include "rp/core/RoboticObject.hpp"
 
 #include <cxxabi.h>
+#include <pthread.h>
+#include <time.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
@@ -43,6 +46,7 @@ struct RoboticObject::Impl {
   std::uint64_t id = 0;
   std::shared_ptr<const Configuration> configuration;  // keeps `section` alive
   const ConfigSection* section = nullptr;
+  std::string configuredClass;  // named by the constructor (ClassSection), or empty
 
   // Error status: a tiny spin lock taken with a bounded number of attempts by writers.
   mutable std::atomic_flag errorLock = ATOMIC_FLAG_INIT;
@@ -59,6 +63,17 @@ struct RoboticObject::Impl {
   std::thread::id constructor;           // the thread that constructed the object
   const RoboticObject* parent = nullptr;  // published with this object (with the registry lock)
 
+  // Additional threads (addThread()): started by startControlLoop(), stopped by stopControlLoop().
+  struct ExtraThread {
+    std::string name;
+    std::function<void(const std::atomic<bool>&)> body;
+    std::thread thread;
+  };
+  mutable std::mutex threadMutex;
+  std::vector<ExtraThread> threads;
+  std::atomic<bool> threadsStarted{false};
+  std::atomic<bool> stopThreads{false};
+
   std::mutex commandMutex;
   struct Command {
     std::string name, description;
@@ -71,7 +86,11 @@ RoboticObject::RoboticObject(const std::string& name) : impl_(std::make_unique<I
   auto& reg = internal::registry();
   impl_->automatic = name.empty();
   impl_->configuration = internal::currentConfiguration();
+  // The section named after the object wins; without one, the section named after its class.
+  if (const char* className = ClassSection::claim()) impl_->configuredClass = className;
   if (!name.empty()) impl_->section = impl_->configuration->findSection(name);
+  if (impl_->section == nullptr && !impl_->configuredClass.empty())
+    impl_->section = impl_->configuration->findClassSection(impl_->configuredClass);
   {
     std::lock_guard<std::recursive_mutex> lock(reg.mutex);
     if (!name.empty())
@@ -90,6 +109,7 @@ RoboticObject::RoboticObject(const std::string& name) : impl_(std::make_unique<I
 
 RoboticObject::~RoboticObject() {
   withdrawObject();  // normally done already by the most-derived destructor
+  stopThreads();     // likewise (by stopControlLoop())
   auto& reg = internal::registry();
   std::lock_guard<std::recursive_mutex> lock(reg.mutex);
   reg.objects.erase(std::remove(reg.objects.begin(), reg.objects.end(), this), reg.objects.end());
@@ -107,6 +127,8 @@ std::string RoboticObject::getClassName() const {
 }
 
 const ConfigSection* RoboticObject::configSection() const noexcept { return impl_->section; }
+
+std::string RoboticObject::getConfiguredClass() const { return impl_->configuredClass; }
 
 void RoboticObject::setError(int code, const char* message) noexcept {
   // Bounded attempts: a real-time writer never waits long for a non-real-time one.
@@ -209,8 +231,9 @@ bool RoboticObject::handleMessage(const std::string&, const std::string&, std::s
 void RoboticObject::startControlLoop() {
   if (ControlProgram* p = getControlProgram()) {
     if (p->getProgramName() == "control") p->setProgramName(getName());
-    if (!p->isRunning()) p->start();
+    if (!p->isRunning() && !impl_->threadsStarted.load()) p->start();  // once: a stopped loop stays stopped
   }
+  startThreads();
   publishObject();  // the most-derived constructor calls this last: the object is complete
 }
 
@@ -218,6 +241,104 @@ void RoboticObject::stopControlLoop() {
   beforeControlLoopStops();  // e.g. a manipulator's hold until the arm is at rest
   withdrawObject();  // the destructors call this first: other threads keep off from here on
   if (ControlProgram* p = getControlProgram()) p->stop();
+  stopThreads();
+}
+
+namespace {
+void runThread(const std::string& name, const std::function<void(const std::atomic<bool>&)>& body,
+               const std::atomic<bool>& stop, RoboticObject& object) {
+  const std::string shortName = name.substr(0, 15);
+  pthread_setname_np(pthread_self(), shortName.c_str());
+  try {
+    body(stop);
+  } catch (const std::exception& e) {
+    object.setError(1, (object.getName() + ": thread '" + name + "' failed: " + e.what()).c_str());
+  } catch (...) {
+    object.setError(1, (object.getName() + ": thread '" + name + "' failed").c_str());
+  }
+}
+}  // namespace
+
+void RoboticObject::addThread(const std::string& name, std::function<void(const std::atomic<bool>& stop)> body) {
+  if (!body) throw std::invalid_argument("addThread: no function for thread '" + name + "' of " + getName());
+  std::lock_guard<std::mutex> lock(impl_->threadMutex);
+  impl_->threads.push_back({name, std::move(body), {}});
+  if (impl_->threadsStarted.load() && !impl_->stopThreads.load()) {
+    auto& t = impl_->threads.back();
+    t.thread = std::thread(runThread, t.name, t.body, std::cref(impl_->stopThreads), std::ref(*this));
+  }
+}
+
+void RoboticObject::addPeriodicThread(const std::string& name, double periodSeconds, std::function<void()> cycle) {
+  if (!(periodSeconds > 0 && periodSeconds <= 3600))
+    throw std::invalid_argument("addPeriodicThread: the period of thread '" + name + "' of " + getName() +
+                                " must be more than 0 and at most 3600 s, got " + std::to_string(periodSeconds));
+  if (!cycle) throw std::invalid_argument("addPeriodicThread: no function for thread '" + name + "' of " + getName());
+  const long long periodNs = static_cast<long long>(periodSeconds * 1e9) > 0 ? static_cast<long long>(periodSeconds * 1e9) : 1;
+  addThread(name, [periodNs, cycle = std::move(cycle)](const std::atomic<bool>& stop) {
+    timespec next{};
+    clock_gettime(CLOCK_MONOTONIC, &next);
+    auto advance = [&](timespec& t) {
+      const long long ns = static_cast<long long>(t.tv_nsec) + periodNs;
+      t.tv_sec += static_cast<time_t>(ns / 1000000000LL);
+      t.tv_nsec = static_cast<long>(ns % 1000000000LL);
+    };
+    while (!stop.load(std::memory_order_acquire)) {
+      cycle();
+      advance(next);
+      timespec now{};
+      clock_gettime(CLOCK_MONOTONIC, &now);
+      if (now.tv_sec > next.tv_sec || (now.tv_sec == next.tv_sec && now.tv_nsec > next.tv_nsec)) {
+        next = now;  // late: the next cycle starts now, the missed ones are not repeated
+        continue;
+      }
+      // Sleep in slices of at most 50 ms, so a stop request is seen soon even with a long period.
+      while (!stop.load(std::memory_order_acquire)) {
+        timespec slice = now;
+        const long long ns = static_cast<long long>(slice.tv_nsec) + 50000000LL;
+        slice.tv_sec += static_cast<time_t>(ns / 1000000000LL);
+        slice.tv_nsec = static_cast<long>(ns % 1000000000LL);
+        const bool last = slice.tv_sec > next.tv_sec || (slice.tv_sec == next.tv_sec && slice.tv_nsec >= next.tv_nsec);
+        const timespec until = last ? next : slice;
+        while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &until, nullptr) == EINTR) {
+        }
+        if (last) break;
+        now = until;
+      }
+    }
+  });
+}
+
+std::vector<std::string> RoboticObject::getThreadNames() const {
+  std::lock_guard<std::mutex> lock(impl_->threadMutex);
+  std::vector<std::string> names;
+  for (const auto& t : impl_->threads) names.push_back(t.name);
+  return names;
+}
+
+bool RoboticObject::areThreadsRunning() const noexcept {
+  return impl_->threadsStarted.load() && !impl_->stopThreads.load();
+}
+
+void RoboticObject::startThreads() {
+  std::lock_guard<std::mutex> lock(impl_->threadMutex);
+  if (impl_->threadsStarted.exchange(true) || impl_->stopThreads.load()) return;
+  for (auto& t : impl_->threads)
+    if (!t.thread.joinable())
+      t.thread = std::thread(runThread, t.name, t.body, std::cref(impl_->stopThreads), std::ref(*this));
+}
+
+void RoboticObject::stopThreads() noexcept {
+  std::vector<std::thread> running;
+  {
+    std::lock_guard<std::mutex> lock(impl_->threadMutex);
+    impl_->stopThreads.store(true, std::memory_order_release);
+    for (auto& t : impl_->threads)
+      if (t.thread.joinable()) running.push_back(std::move(t.thread));
+  }
+  for (auto& t : running)
+    if (t.get_id() != std::this_thread::get_id()) t.join();
+    else t.detach();  // a thread stopping its own object
 }
 
 void RoboticObject::publishObject() noexcept {

@@ -5,7 +5,7 @@
 
 namespace rp {
 
-AtiFTSensor::AtiFTSensor(const std::string& name) : ForceTorqueSensor(name) {
+AtiFTSensor::AtiFTSensor(const std::string& name) : ForceTorqueSensor(ClassSection(name, "AtiFTSensor")) {
   NetFtClient::Config config;
   if (const ConfigSection* section = configSection()) {
     if (section->has("address")) config.address = section->getWord("address");
@@ -33,11 +33,11 @@ AtiFTSensor::AtiFTSensor(const std::string& name) : ForceTorqueSensor(name) {
   } else {
     client_ = std::make_unique<NetFtClient>(config);
   }
-  publishObject();  // complete: other threads (the Scene Viewer) may use it
+  startControlLoop();  // complete: the update thread starts, other threads (the Scene Viewer) may use it
 }
 
 AtiFTSensor::~AtiFTSensor() {
-  withdrawObject();  // first: other threads keep off from here on
+  stopControlLoop();  // first: other threads keep off from here on, the update thread ends
   if (streaming_) client_->stopStreaming();
 }
 

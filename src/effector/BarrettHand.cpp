@@ -8,7 +8,7 @@
 
 namespace rp {
 
-BarrettHand::BarrettHand(const std::string& name) : Gripper(name) {
+BarrettHand::BarrettHand(const std::string& name) : Gripper(ClassSection(name, "BarrettHand")) {
   if (const ConfigSection* section = configSection()) {
     if (!section->has("port"))
       throw ConfigError(section->fileName(), section->line(),

@@ -7,7 +7,7 @@
 
 namespace rp {
 
-DefaultGripper::DefaultGripper(const std::string& name) : Gripper(name) {
+DefaultGripper::DefaultGripper(const std::string& name) : Gripper(ClassSection(name, "DefaultGripper")) {
   const ConfigSection* section = configSection();
   if (section == nullptr) {
     publishObject();  // complete: other threads (the Scene Viewer) may use it

@@ -7,7 +7,8 @@
 
 namespace rp {
 
-DefaultToolChanger::DefaultToolChanger(const std::string& name) : ToolChanger(name) {
+DefaultToolChanger::DefaultToolChanger(const std::string& name)
+    : ToolChanger(ClassSection(name, "DefaultToolChanger")) {
   const ConfigSection* section = configSection();
   if (section == nullptr) {
     publishObject();  // complete: other threads (the Scene Viewer) may use it

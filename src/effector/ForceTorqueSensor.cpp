@@ -1,5 +1,6 @@
 #include "rp/effector/ForceTorqueSensor.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 #include <sstream>
@@ -30,8 +31,12 @@ ForceTorqueSensor::ForceTorqueSensor(const std::string& name) : PhysicalObject(n
       if (n < 1 || n > 1e6) throw section->errorAt(*s, "setting 'maxMissedCycles' must be 1 .. 1000000");
       maxMissedCycles_ = static_cast<int>(n);
     }
+    if (section->has("updateRate")) updateRate_ = section->getNumbers("updateRate").at(0);
   }
   addCommand("Bias", [this] { bias(); }, "take the current load as zero");
+  // The library drives update(): a thread of the sensor's own, started by the most-derived
+  // constructor's startControlLoop() (RoboticObject's additional threads).
+  if (updateRate_ > 0) addPeriodicThread("ft-update", 1.0 / updateRate_, [this] { update(); });
 }
 
 ForceTorqueSensor::~ForceTorqueSensor() = default;
@@ -44,6 +49,9 @@ void ForceTorqueSensor::declareSettings(SettingSchema& schema) {
   schema.setDefault("payload", "0");
   schema.setDefault("payloadCenter", "0 0 0");
   schema.setDefault("maxMissedCycles", "50");
+  schema.addNumbers("updateRate", 1, "Hz",
+                    "rate of the sensor's update thread, which calls update(); 0: the program calls it", 0, 20000);
+  schema.setDefault("updateRate", "1000");
 }
 
 void ForceTorqueSensor::setSimulatedWrench(const Vector<3>& force, const Vector<3>& torque) {
@@ -81,6 +89,7 @@ void ForceTorqueSensor::fail(const char* what) noexcept {
 }
 
 bool ForceTorqueSensor::read(Vector<3>& force, Vector<3>& torque) {
+  std::lock_guard sensor(sensorMutex_);
   if (isSimulationModeOn()) {
     simulatedReading(force, torque);
   } else {
@@ -97,6 +106,7 @@ bool ForceTorqueSensor::read(Vector<3>& force, Vector<3>& torque) {
 }
 
 bool ForceTorqueSensor::bias() {
+  std::lock_guard sensor(sensorMutex_);
   if (isSimulationModeOn()) {
     Vector<3> f, t;
     {
@@ -119,6 +129,8 @@ bool ForceTorqueSensor::bias() {
 
 bool ForceTorqueSensor::update() noexcept {
   if (shutdownRequested_.load()) return false;
+  std::unique_lock sensor(sensorMutex_, std::try_to_lock);
+  if (!sensor.owns_lock()) return true;  // read() or bias() has the sensor: skip, never wait
   Vector<3> force, torque;
   if (isSimulationModeOn()) {
     // Simulation reads only fixed-size values (the lock is uncontended in practice).
@@ -132,7 +144,9 @@ bool ForceTorqueSensor::update() noexcept {
     missedCycles_ = 0;
     return true;
   }
-  const bool tolerated = (s == IoStatus::kTimeout || s == IoStatus::kProtocolError) && ++missedCycles_ < maxMissedCycles_;
+  // Until the first reading the stream may take a while to start: up to 2 s of the update thread.
+  const int limit = count_ == 0 ? std::max(maxMissedCycles_, static_cast<int>(2.0 * updateRate_)) : maxMissedCycles_;
+  const bool tolerated = (s == IoStatus::kTimeout || s == IoStatus::kProtocolError) && ++missedCycles_ < limit;
   if (tolerated) return true;
   char message[256];
   std::snprintf(message, sizeof message, "%s (after %d cycles without a reading)", hardwareError(), missedCycles_);

@@ -32,6 +32,7 @@
 #include <set>
 #include <thread>
 
+#include "OpenInBrowser.hpp"
 #include "SceneState.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/PhysicalObject.hpp"
@@ -1232,8 +1233,9 @@ void SceneViewer::startFromPlatform() {
     const std::string url = instance().getUrl();
     const std::string token = instance().getToken();
     const std::size_t root = url.find('/', url.find("//") + 2);  // end of http://host:port
-    std::cerr << "rp: QMotor at " << url.substr(0, root) << "/qmotor.html" << (token.empty() ? "" : "?token=" + token)
-              << std::endl;
+    const std::string qmotor = url.substr(0, root) + "/qmotor.html" + (token.empty() ? "" : "?token=" + token);
+    std::cerr << "rp: QMotor at " << qmotor << std::endl;
+    internal::openInBrowser(qmotor, "-qmotor");  // the default browser when there is a display
   }
 }
 

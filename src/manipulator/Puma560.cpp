@@ -7,19 +7,20 @@
 namespace rp {
 
 namespace {
-double pedestalHeight(const std::string& name) {
-  const ConfigSection* section = RoboticPlatform::getConfiguration().findSection(name);
+double pedestalHeight(const ConfigSection* section) {
   if (section != nullptr && section->has("pedestalHeight")) return section->getNumbers("pedestalHeight").at(0);
   return 0.67183;
 }
 }  // namespace
 
-Puma560::Puma560(const std::string& name)
-    : DefaultManipulator(name, [name](const Transform& base) {
-        return std::make_unique<Puma560Model>(pedestalHeight(name), base);
-      }) {
+Puma560::Puma560(const std::string& name) : Puma560(ClassSection(name, "Puma560"), DerivedClass{}) {
   startControlLoop();
 }
+
+Puma560::Puma560(const std::string& name, DerivedClass)
+    : DefaultManipulator(name, [this](const Transform& base) {
+        return std::make_unique<Puma560Model>(pedestalHeight(configSection()), base);
+      }) {}
 
 Puma560::~Puma560() { stopControlLoop(); }
 

@@ -15,8 +15,8 @@ namespace rp {
 
 namespace {
 // The URDF file and tip link: rp.cfg's settings override the constructor's arguments.
-std::pair<std::string, std::string> resolve(const std::string& name, std::string file, std::string tip) {
-  if (const ConfigSection* section = RoboticPlatform::getConfiguration().findSection(name)) {
+std::pair<std::string, std::string> resolve(const ConfigSection* section, std::string file, std::string tip) {
+  if (section != nullptr) {
     if (section->has("urdf")) {
       file = section->getWord("urdf");
       const std::filesystem::path p(file);
@@ -27,9 +27,10 @@ std::pair<std::string, std::string> resolve(const std::string& name, std::string
   return {file, tip};
 }
 
-std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, const std::string& urdfFile,
-                                          const std::string& tipLink, const Transform& base) {
-  const auto [file, tip] = resolve(name, urdfFile, tipLink);
+std::unique_ptr<ManipulatorModel> loadFor(const ConfigSection* section, const std::string& name,
+                                          const std::string& urdfFile, const std::string& tipLink,
+                                          const Transform& base) {
+  const auto [file, tip] = resolve(section, urdfFile, tipLink);
   if (file.empty()) throw std::invalid_argument("UrdfManipulator '" + name + "': no URDF file (rp.cfg setting 'urdf')");
   UrdfOptions options;
   options.tip = tip;
@@ -50,15 +51,17 @@ std::unique_ptr<ManipulatorModel> loadFor(const std::string& name, const std::st
 }  // namespace
 
 UrdfManipulator::UrdfManipulator(const std::string& name, const std::string& urdfFile, const std::string& tip)
-    : DefaultManipulator(name, [name, urdfFile, tip](const Transform& base) { return loadFor(name, urdfFile, tip, base); }) {
-  std::tie(urdfFile_, tip_) = resolve(getName(), urdfFile, tip);
+    : DefaultManipulator(ClassSection(name, "UrdfManipulator"), [this, urdfFile, tip](const Transform& base) {
+        return loadFor(configSection(), getName(), urdfFile, tip, base);
+      }) {
+  std::tie(urdfFile_, tip_) = resolve(configSection(), urdfFile, tip);
   startControlLoop();
 }
 
 UrdfManipulator::~UrdfManipulator() { stopControlLoop(); }
 
 std::vector<std::string> UrdfManipulator::getPackagePath() const {
-  if (const ConfigSection* section = RoboticPlatform::getConfiguration().findSection(getName()))
+  if (const ConfigSection* section = configSection())
     if (section->has("packagePath"))
       return splitPackagePath(section->getWord("packagePath"),
                               std::filesystem::path(section->fileName()).parent_path().string());

@@ -9,8 +9,7 @@
 namespace rp {
 
 namespace {
-int linkCount(const std::string& name, int links) {
-  const ConfigSection* section = RoboticPlatform::getConfiguration().findSection(name);
+int linkCount(const ConfigSection* section, const std::string& name, int links) {
   if (section != nullptr && section->has("links")) links = std::stoi(section->getWord("links"));
   if (links != 4 && links != 7) {
     throw std::invalid_argument("WAM '" + name + "': " + std::to_string(links) + " links; a WAM has 4 or 7");
@@ -19,13 +18,15 @@ int linkCount(const std::string& name, int links) {
 }
 }  // namespace
 
-WAM::WAM(const std::string& name, int links)
-    : DefaultManipulator(name, [name, links](const Transform& base) -> std::unique_ptr<ManipulatorModel> {
-        if (linkCount(name, links) == 4) return std::make_unique<WAM4Model>(base);
-        return std::make_unique<WAM7Model>(base);
-      }) {
+WAM::WAM(const std::string& name, int links) : WAM(ClassSection(name, "WAM"), links, DerivedClass{}) {
   startControlLoop();
 }
+
+WAM::WAM(const std::string& name, int links, DerivedClass)
+    : DefaultManipulator(name, [this, links](const Transform& base) -> std::unique_ptr<ManipulatorModel> {
+        if (linkCount(configSection(), getName(), links) == 4) return std::make_unique<WAM4Model>(base);
+        return std::make_unique<WAM7Model>(base);
+      }) {}
 
 WAM::~WAM() { stopControlLoop(); }
 

@@ -22,6 +22,8 @@ export function startProgram(program, args = [], { cwd } = {}) {
   const proc = spawn(join(BIN, program), args, {
     cwd: cwd || workDir,
     stdio: ['ignore', 'pipe', 'pipe'],
+    // No display: a -qmotor program prints its URL and opens no browser of the user's.
+    env: { ...process.env, DISPLAY: '', WAYLAND_DISPLAY: '' },
   });
   let out = '';
   const onData = (d) => {

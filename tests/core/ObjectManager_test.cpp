@@ -20,7 +20,6 @@ using test::TestFunction;
 class ObjectManagerTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_TRUE(test::standInsRegistered);
     RoboticPlatform::setConfiguration(Configuration::parse(
         "[arm]\nclass TestArm\nposition 300 0 0\norientation 0 0 90\nsimulationMode off\ndisplay wireframe\n"
         "port /dev/ser1\n\n[func]\nclass TestFunction\n\n[slow]\nclass SlowShutdown\n",

@@ -41,7 +41,6 @@ class SlowShutdown : public PhysicalObject {
   mutable std::atomic<int> polls{0};
 };
 
-extern bool standInsRegistered;  // the Figure 9 stand-ins are registered
 
 // A directory under the build tree, emptied for each use.
 inline std::filesystem::path scratchDirectory(const std::string& name) {

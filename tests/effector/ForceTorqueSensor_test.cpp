@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include "AllocationCounter.hpp"
 #include "EffectorTestSupport.hpp"
@@ -28,7 +32,7 @@ class ForceTorqueSensorTest : public test::EffectorTest {};
 
 TEST_F(ForceTorqueSensorTest, SimulationReportsPayloadWeightAndExternalWrench) {
   // Sensor rotated 90 deg about x: world -z is sensor +y... (R^T (0,0,-mg)).
-  configure("[ft]\nclass AtiFTSensor\norientation 90 0 0\npayload 2\npayloadCenter 0 0 100\n");
+  configure("[ft]\nclass AtiFTSensor\norientation 90 0 0\npayload 2\npayloadCenter 0 0 100\nupdateRate 0\n");
   auto* ft = om_.createDerivedObject<ForceTorqueSensor>("ft");
   ASSERT_TRUE(ft->isSimulationModeOn());
   Vector<3> f, t;
@@ -59,13 +63,52 @@ TEST_F(ForceTorqueSensorTest, SimulationReportsPayloadWeightAndExternalWrench) {
   EXPECT_EQ(commands[0].name, "Bias");
 }
 
+// Waits up to 10 s for `done`.
+template <typename F>
+bool waitFor(F done) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+TEST_F(ForceTorqueSensorTest, TheLibraryDrivesUpdate) {
+  configure("[ft]\nclass AtiFTSensor\npayload 2\n");  // default updateRate 1000
+  auto* ft = om_.createDerivedObject<ForceTorqueSensor>("ft");
+  EXPECT_EQ(ft->getUpdateRate(), 1000.0);
+  EXPECT_EQ(ft->getThreadNames(), std::vector<std::string>{"ft-update"});
+  EXPECT_TRUE(ft->areThreadsRunning());
+  // Nobody calls read() or update(): the sensor's own thread takes the readings.
+  ASSERT_TRUE(waitFor([&] { return ft->getLastReading().count >= 20; })) << ft->getLastReading().count;
+  EXPECT_NEAR(ft->getLastReading().force[2], -2.0 * 9.80665, 1e-9);
+  ft->setSimulatedWrench(vec3(0.0, 0.0, 5.0), vec3(0.0, 0.0, 0.0));
+  EXPECT_TRUE(waitFor([&] { return std::abs(ft->getLastReading().force[2] - (5.0 - 2.0 * 9.80665)) < 1e-9; }));
+  // read() takes turns with the thread.
+  Vector<3> f, t;
+  for (int i = 0; i < 50; ++i) ASSERT_TRUE(ft->read(f, t));
+  EXPECT_NEAR(f[2], 5.0 - 2.0 * 9.80665, 1e-9);
+  om_.deleteObject(ft);  // stops and joins the thread
+}
+
+TEST_F(ForceTorqueSensorTest, UpdateRateZeroLeavesUpdateToTheProgram) {
+  configure("[ft]\nclass AtiFTSensor\nupdateRate 0\n");
+  auto* ft = om_.createDerivedObject<ForceTorqueSensor>("ft");
+  EXPECT_TRUE(ft->getThreadNames().empty());
+  EXPECT_EQ(ft->getLastReading().count, 0u);
+  EXPECT_TRUE(ft->update());
+  EXPECT_EQ(ft->getLastReading().count, 1u);
+}
+
 class AtiFTSensorTest : public test::EffectorTest {
  protected:
   void SetUp() override {
     sensor_.setWrench({4.0, -5.0, 6.0, 0.25, -0.5, 0.75});
     sensor_.start();
     configure("[ft]\nclass AtiFTSensor\nsimulationMode off\naddress 127.0.0.1\nport " + std::to_string(sensor_.port()) +
-              "\ncountsPerForce 1000000\ncountsPerTorque 1000000\ntimeout 300\nmaxMissedCycles 20\n");
+              "\ncountsPerForce 1000000\ncountsPerTorque 1000000\ntimeout 300\nmaxMissedCycles 20\n"
+              "updateRate 0\n");  // these tests call update() as a program's own loop does
   }
   void TearDown() override {
     if (ObjectManager::isShutdownRequested()) {
@@ -131,10 +174,24 @@ TEST_F(AtiFTSensorTest, SensorDyingInTheServoLoopRequestsASafeShutdown) {
   EXPECT_EQ(ObjectManager::getShutdownReason(), "force/torque sensor failed");
 }
 
+TEST_F(AtiFTSensorTest, SensorDyingUnderTheLibrarysUpdateThreadRequestsASafeShutdown) {
+  configure("[ft]\nclass AtiFTSensor\nsimulationMode off\naddress 127.0.0.1\nport " + std::to_string(sensor_.port()) +
+            "\ntimeout 300\nmaxMissedCycles 100\nupdateRate 1000\n");
+  auto* ft = om_.createDerivedObject<AtiFTSensor>("ft");
+  ASSERT_TRUE(waitFor([&] { return ft->getLastReading().count > 0; })) << ft->getErrorStatus().message;
+  EXPECT_NEAR(ft->getLastReading().force[0], 4.0, 1e-6) << "the streamed wrench, read by the update thread";
+  EXPECT_FALSE(ObjectManager::isShutdownRequested());
+  sensor_.stop();
+  ASSERT_TRUE(waitFor([] { return ObjectManager::isShutdownRequested(); }));
+  EXPECT_EQ(ObjectManager::getShutdownReason(), "force/torque sensor failed");
+  EXPECT_EQ(ft->getErrorCode(), 1);
+  EXPECT_TRUE(contains(ft->getErrorStatus().message, "cycles without a reading")) << ft->getErrorStatus().message;
+}
+
 TEST_F(AtiFTSensorTest, AbsentSensorIsAnError) {
   const int port = sensor_.port();
   sensor_.stop();
-  configure("[ft]\nclass AtiFTSensor\nsimulationMode off\nport " + std::to_string(port) + "\ntimeout 100\n");
+  configure("[ft]\nclass AtiFTSensor\nsimulationMode off\nport " + std::to_string(port) + "\ntimeout 100\nupdateRate 0\n");
   auto* ft = om_.createDerivedObject<ForceTorqueSensor>("ft");
   Vector<3> f, t;
   EXPECT_FALSE(ft->read(f, t));

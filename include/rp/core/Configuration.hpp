@@ -181,6 +181,9 @@ class ConfigSection {
   const std::string& className() const noexcept { return className_; }
   /// Line of the `[name]` header.
   int line() const noexcept { return line_; }
+  /// Whether this is a class section: named after its class (`[Puma560]` with `class Puma560`),
+  /// it configures the objects of that class that have no section of their own.
+  bool isClassSection() const noexcept { return name_ == className_; }
   /// Line of the `class` setting.
   int classLine() const noexcept { return classLine_; }
   /// File the section is in.
@@ -222,6 +225,10 @@ class ConfigSection {
 /// `#` starts a comment (at the start of a line or after white space); blank lines are ignored.
 /// Outside sections only `plugin path/to/libfoo.so` is allowed: the library is loaded before the
 /// classes are checked, so classes it registers can be named in the file.
+///
+/// A section named after a registered class (`[Puma560]`) is a class section: its `class` must be
+/// that class, and it configures every object of the class that has no section of its own (the
+/// paper's unnamed `Puma560 puma;`); see RoboticObject::configSection().
 class Configuration {
  public:
   /// How much of the file to check.
@@ -264,6 +271,9 @@ class Configuration {
   /// The section `[name]`, or nullptr.
   /// @param[in] name  object name
   const ConfigSection* findSection(const std::string& name) const;
+  /// The class section of class `className` (`[Puma560]` with `class Puma560`), or nullptr.
+  /// @param[in] className  a class name
+  const ConfigSection* findClassSection(const std::string& className) const;
   /// The section names, comma separated, for error messages.
   std::string sectionNames() const;
   /// The `plugin` lines (paths as resolved against the file's folder).

@@ -2,6 +2,7 @@
 /// @file
 /// The core classes: objects, object manager, type database, configuration and platform start-up.
 
+#include "rp/core/ClassSection.hpp"
 #include "rp/core/Configuration.hpp"
 #include "rp/core/FunctionalObject.hpp"
 #include "rp/core/ObjectManager.hpp"

@@ -94,7 +94,16 @@ class ObjectManager {
   /// @param[in] name  object name = rp.cfg section
   /// @throws ObjectError, ConfigError as createDerivedObject()
   RoboticObject* createObject(const std::string& name) { return createDerivedObject<RoboticObject>(name); }
-  /// Creates every object of the global configuration, in file order.
+  /// Creates an unnamed object of the registered class `className`, as the program's
+  /// `Puma560 puma;` would: configured from the class section `[className]` if rp.cfg has one.
+  /// The manager owns it like the objects of createDerivedObject().
+  /// @param[in] className  a registered class name
+  /// @throws ObjectError if the class is not registered
+  /// @throws ConfigError if the object's settings are invalid
+  /// Real-time safe: no.
+  RoboticObject* createClassObject(const std::string& className);
+  /// Creates every object of the global configuration, in file order. Class sections
+  /// (`[Puma560]` with `class Puma560`) configure other objects and create none.
   /// @throws ObjectError, ConfigError as createDerivedObject()
   std::vector<RoboticObject*> createAllObjects();
   /// Destroys an object created by this manager.

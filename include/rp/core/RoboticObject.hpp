@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "rp/core/ClassSection.hpp"
 #include "rp/core/Configuration.hpp"
 
 namespace rp {
@@ -84,7 +85,9 @@ struct ObjectInfo {
 /// An object registers with the ObjectManager in its constructor and leaves it in its
 /// destructor, from any thread. An object created with a name is configured from the rp.cfg
 /// section of that name (each constructor level reads its own settings from configSection());
-/// an object created without a name gets a unique automatic name such as `object_3`.
+/// an object created without a name gets a unique automatic name such as `object_3` and is
+/// configured from the section named after its class, `[Puma560]`, if rp.cfg has one (see
+/// ClassSection); so is a named object whose name has no section.
 ///
 /// Threads: an object is in the ObjectManager's list from the start of its construction to the
 /// end of its destruction. Its name is safe to read from any thread at any time. Other threads
@@ -125,8 +128,15 @@ class RoboticObject {
   /// Class name as registered in the type database (or the C++ name without namespaces).
   /// Real-time safe: no.
   virtual std::string getClassName() const;
-  /// The rp.cfg section of this object, or nullptr if there is none.
+  /// The rp.cfg section that configures this object, or nullptr if there is none: the section
+  /// named after the object (`[leader]`) if there is one, otherwise the section named after its
+  /// class (`[Puma560]`, for unnamed objects and named ones without a section of their own; the
+  /// class is the one its constructor names with ClassSection, or the registered class for
+  /// objects created by name). The two are never merged: a named section replaces the class's.
   const ConfigSection* configSection() const noexcept;
+  /// The class whose section an object without a section of its own is configured from (see
+  /// ClassSection), or an empty string if its constructor named none.
+  std::string getConfiguredClass() const;
 
   /// @name Error handling
   /// @{
@@ -208,16 +218,42 @@ class RoboticObject {
   virtual ControlProgram* getControlProgram() { return nullptr; }
   /// Whether the object needs a control loop.
   bool needsControlLoop() { return getControlProgram() != nullptr; }
-  /// Starts the object's control loop in its own thread (the most-derived constructor calls this
-  /// last, so the loop never sees a half-constructed object), then publishes the object
-  /// (publishObject()). Without a loop it only publishes the object.
+  /// Starts the object's threads: its control loop (if getControlProgram() returns one) and the
+  /// additional threads it asked for (addThread(), addPeriodicThread()), then publishes the
+  /// object (publishObject()). The most-derived constructor calls it last, so no thread ever sees
+  /// a half-constructed object (C++ runs no code of a base class after the most-derived
+  /// constructor: the library's classes call it, and ObjectManager's factory calls it for every
+  /// object it creates, so a class created by name needs no call). Calling it again does nothing.
   /// Real-time safe: no.
   void startControlLoop();
   /// Lets the object bring what its loop drives to a safe state (beforeControlLoopStops()),
   /// withdraws the object from other threads (withdrawObject()), then stops the control loop and
-  /// waits for its thread (derived destructors call this first).
+  /// the additional threads and waits for them (derived destructors call this first; the
+  /// RoboticObject destructor stops and joins any thread still running). Calling it again does
+  /// nothing more.
   /// Real-time safe: no.
   void stopControlLoop();
+  /// Asks for an additional thread (paper section 3.2, "Thread Management"): `body` runs in a
+  /// thread of its own from startControlLoop() (at once if that has run already) and must return
+  /// soon after `stop` becomes true, which stopControlLoop() and the destructor set before they
+  /// wait for it. An exception escaping `body` sets the object's error status (code 1).
+  /// @param[in] name  thread name (shown by `top -H`; the first 15 bytes)
+  /// @param[in] body  what the thread does
+  /// Real-time safe: no.
+  void addThread(const std::string& name, std::function<void(const std::atomic<bool>& stop)> body);
+  /// Asks for an additional periodic thread: `cycle` is called every `periodSeconds` (absolute
+  /// deadlines on the monotonic clock; a late cycle is not repeated) from startControlLoop() until
+  /// stopControlLoop(), in the same way as addThread(). The loop itself does not allocate.
+  /// @param[in] name           thread name
+  /// @param[in] periodSeconds  period [s], more than 0 and at most 3600
+  /// @param[in] cycle          what each cycle does
+  /// @throws std::invalid_argument for a period out of range
+  /// Real-time safe: no.
+  void addPeriodicThread(const std::string& name, double periodSeconds, std::function<void()> cycle);
+  /// The names of the additional threads asked for, in order. Real-time safe: no.
+  std::vector<std::string> getThreadNames() const;
+  /// Whether the additional threads have been started and not yet stopped. Real-time safe: yes.
+  bool areThreadsRunning() const noexcept;
   /// Called first by stopControlLoop() while the loop still runs: a class whose loop drives
   /// hardware waits here until it is safe to stop (a manipulator holds its arm until at rest and
   /// switches the power off). The default does nothing.
@@ -263,6 +299,8 @@ class RoboticObject {
   friend class ObjectReference;
   bool tryReference() noexcept;  // takes a reference if published
   bool isWithdrawn() const noexcept;  // withdrawn: being destroyed
+  void startThreads();  // the additional threads asked for and not yet running
+  void stopThreads() noexcept;  // sets their stop flag and joins them
   void releaseReference() noexcept;
 
   struct Impl;

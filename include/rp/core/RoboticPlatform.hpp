@@ -25,7 +25,7 @@ class Clock;
 /// | `-gui-port <n>` | its TCP port (default 7070 or the next free one; 0: any free port) | setGuiPort() |
 /// | `-gui-token <text>` | token pages must present (generated for a non-loopback address) | setGuiToken() |
 /// | `-config <file>` | the global configuration file (default `rp.cfg`) | setConfigurationFileName() |
-/// | `-qmotor` | print the URL of the QMotor window (live plots and tuning in the browser); with the Scene Viewer off (`-nogui`) there is no window and a warning says so | setQMotorOn() |
+/// | `-qmotor` | open the QMotor window (live plots and tuning) in the default browser with `xdg-open` when a display is present, and print its URL (`rp: QMotor at URL`); without a display only the URL; with the Scene Viewer off (`-nogui`) there is no window and a warning says so | setQMotorOn() |
 /// | `-log <file>` | log every log variable of every control program to one CSV file | setLogFileName() |
 /// | `-simclock` | run control programs on a simulated clock, as fast as possible | useSimulatedClock() |
 /// | `--help` | print the switches and exit 0 | - |
@@ -83,8 +83,9 @@ class RoboticPlatform {
   static void setGuiToken(const std::string& token);
   /// The token set with setGuiToken() (empty if none was given).
   static std::string getGuiToken();
-  /// `-qmotor`: init() prints the URL of the QMotor window (live plots and tuning in the browser);
-  /// with the Scene Viewer off (`-nogui`) there is no window and a warning says so.
+  /// `-qmotor`: init() opens the QMotor window (live plots and tuning) in the default browser
+  /// with `xdg-open` when a display is present (`DISPLAY` or `WAYLAND_DISPLAY`), and prints its
+  /// URL either way; with the Scene Viewer off (`-nogui`) there is no window and a warning says so.
   static void setQMotorOn();
   /// Whether the tuning window is to be opened.
   static bool isQMotorOn();

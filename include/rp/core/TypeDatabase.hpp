@@ -9,6 +9,7 @@
 #include <typeinfo>
 #include <vector>
 
+#include "rp/core/ClassSection.hpp"
 #include "rp/core/Configuration.hpp"
 
 namespace rp {
@@ -49,7 +50,13 @@ class TypeDatabase {
   static bool registerClass(const std::string& name) {
     SettingSchema schema;
     T::declareSettings(schema);
-    instance().add(TypeInfo{name, [](const std::string& objectName) -> RoboticObject* { return new T(objectName); },
+    // The object is created knowing its class (see ClassSection): without a section of its own it
+    // is configured from [name]. `className` lives in the database, which is never destroyed.
+    instance().add(TypeInfo{name,
+                            [className = name](const std::string& objectName) -> RoboticObject* {
+                              const ClassSection section(objectName, className.c_str());
+                              return new T(section);
+                            },
                             [] { throw static_cast<T*>(nullptr); }, std::move(schema), std::type_index(typeid(T))});
     return true;
   }

@@ -31,12 +31,18 @@ struct ForceTorqueReading {
 /// mass in the sensor frame; gravity is -z of the world, rotated by the sensor's pose) plus a
 /// simulated external wrench, minus the bias.
 ///
-/// A servo loop calls update() once per cycle: it never blocks or allocates; when the sensor
-/// fails (closed, garbled, or no new reading for `maxMissedCycles` cycles in a row) it sets the
-/// error status and asks the ObjectManager for a system shutdown, so the arm is brought to rest.
+/// The library drives update(): the sensor asks for an additional periodic thread
+/// (RoboticObject::addPeriodicThread()) that calls it `updateRate` times a second (default
+/// 1000), from the most-derived constructor's startControlLoop() until its destructor. update()
+/// never blocks or allocates; when the sensor fails (closed, garbled, or no new reading for
+/// `maxMissedCycles` cycles in a row; before the first reading, for up to 2 s of the update
+/// thread's cycles) it sets the error status and asks the ObjectManager for a
+/// system shutdown, so the arm is brought to rest. getLastReading() gives the newest reading
+/// without waiting (also in a servo loop). With `updateRate 0` no thread is started and the
+/// program's own loop calls update() every cycle.
 ///
 /// rp.cfg settings (besides PhysicalObject's): `payload MASS` [kg],
-/// `payloadCenter X Y Z` [mm], `maxMissedCycles N` (default 50).
+/// `payloadCenter X Y Z` [mm], `maxMissedCycles N` (default 50), `updateRate HZ` (default 1000).
 class ForceTorqueSensor : public PhysicalObject {
  public:
   /// Creates the sensor and registers its command.
@@ -46,7 +52,7 @@ class ForceTorqueSensor : public PhysicalObject {
   explicit ForceTorqueSensor(const std::string& name = "");
   ~ForceTorqueSensor() override;
 
-  /// Declares `payload`, `payloadCenter` and `maxMissedCycles`.
+  /// Declares `payload`, `payloadCenter`, `maxMissedCycles` and `updateRate`.
   /// @param[out] schema  schema to add to
   static void declareSettings(SettingSchema& schema);
 
@@ -54,14 +60,17 @@ class ForceTorqueSensor : public PhysicalObject {
   /// @param[out] force  force in the sensor frame [N]
   /// @param[out] torque  torque in the sensor frame [N m]
   /// @return true on success; false on a sensor failure (see getErrorStatus())
-  /// Real-time safe: no. Do not call concurrently with update().
+  /// Real-time safe: no. May be called while the library's thread runs update() (the two take
+  /// turns at the sensor).
   bool read(Vector<3>& force, Vector<3>& torque);
   /// Takes the current load as zero (the sensor's own bias command on hardware).
   /// @return true on success; false on a sensor failure
   /// Real-time safe: no.
   bool bias();
-  /// One servo cycle: fetches the newest reading without waiting; on a sensor failure sets the
-  /// error status and requests a system shutdown (once).
+  /// One cycle of the sensor's update thread (or of the program's loop with `updateRate 0`):
+  /// fetches the newest reading without waiting; on a sensor failure sets the error status and
+  /// requests a system shutdown (once). While read() or bias() holds the sensor the cycle is
+  /// skipped (it does not wait) and counts as healthy.
   /// @return true if the sensor is healthy (a new reading, or a tolerated gap)
   /// Real-time safe: yes on hardware (a non-blocking receive into fixed buffers, proven
   /// allocation-free by the tests); in simulation it takes two short, uncontended locks to read
@@ -70,6 +79,8 @@ class ForceTorqueSensor : public PhysicalObject {
 
   /// The last reading (from read() or update()). Real-time safe: no (readers share a mutex).
   ForceTorqueReading getLastReading() const;
+  /// The rate of the update thread [Hz]; 0 when the program calls update() itself.
+  double getUpdateRate() const noexcept { return updateRate_; }
 
   /// Sets the simulated external wrench on the sensor.
   /// @param[in] force  force in the sensor frame [N]
@@ -113,6 +124,8 @@ class ForceTorqueSensor : public PhysicalObject {
   void fail(const char* what) noexcept;
   void publish(const Vector<3>& force, const Vector<3>& torque) noexcept;
 
+  std::mutex sensorMutex_;  // read(), bias() and update() take turns at the sensor (update(): try_lock)
+  double updateRate_ = 1000;
   mutable std::mutex simMutex_;
   Vector<3> simForce_ = Vector<3>::Zero(), simTorque_ = Vector<3>::Zero();
   double payloadMass_ = 0.0;

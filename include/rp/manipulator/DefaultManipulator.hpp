@@ -74,6 +74,11 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
  public:
   /// Makes the model once the object's pose (rp.cfg `position`/`orientation`) is known.
   using ModelFactory = std::function<std::unique_ptr<ManipulatorModel>(const Transform& base)>;
+  /// Tag of the protected constructors of the arm classes (Puma560, WAM) for classes derived
+  /// from them: those constructors do not start the servo loop, the derived class's constructor
+  /// calls startControlLoop() last (and its destructor stopControlLoop() first), so the loop
+  /// never runs on a half-built object.
+  struct DerivedClass {};
 
   /// Creates the manipulator. Derived classes call startControlLoop() at the end of their
   /// constructor.

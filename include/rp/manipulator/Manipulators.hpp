@@ -4,6 +4,7 @@
 
 #include "rp/control/DefaultPositionControl.hpp"
 #include "rp/control/ServoControl.hpp"
+#include "rp/manipulator/BarrettArm.hpp"
 #include "rp/manipulator/DefaultManipulator.hpp"
 #include "rp/manipulator/Manipulator.hpp"
 #include "rp/manipulator/ManipulatorSimulation.hpp"

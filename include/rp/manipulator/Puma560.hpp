@@ -23,6 +23,14 @@ class Puma560 : public DefaultManipulator {
   /// Declares `pedestalHeight`.
   /// @param[out] schema  schema to add to
   static void declareSettings(SettingSchema& schema);
+
+ protected:
+  /// Creates the robot without starting its servo loop, for a class derived from Puma560: its
+  /// constructor passes its own ClassSection and calls startControlLoop() last; its destructor
+  /// calls stopControlLoop() first.
+  /// @param[in] name  object name, with the derived class's ClassSection
+  /// @throws ConfigError for a bad setting
+  Puma560(const std::string& name, DerivedClass);
 };
 
 }  // namespace rp

@@ -22,6 +22,14 @@ class WAM : public DefaultManipulator {
   /// Declares `links`.
   /// @param[out] schema  schema to add to
   static void declareSettings(SettingSchema& schema);
+
+ protected:
+  /// Creates the robot without starting its servo loop: the derived class's constructor calls
+  /// startControlLoop() last (see BarrettArm).
+  /// @param[in] name   object name, with the derived class's ClassSection
+  /// @param[in] links  4 or 7; rp.cfg's `links` setting overrides it
+  /// @throws std::invalid_argument for another number of links; ConfigError for a bad setting
+  WAM(const std::string& name, int links, DerivedClass);
 };
 
 }  // namespace rp

@@ -42,7 +42,8 @@ class DefaultTrajectoryGenerator : public QueueTrajectoryGenerator {
   /// Creates an empty generator and publishes it to other threads (the Scene Viewer lists it;
   /// see RoboticObject::publishObject()).
   /// @param[in] name  object name; empty for an automatic name
-  explicit DefaultTrajectoryGenerator(const std::string& name = "") : QueueTrajectoryGenerator(name) {
+  explicit DefaultTrajectoryGenerator(const std::string& name = "")
+      : QueueTrajectoryGenerator(ClassSection(name, "DefaultTrajectoryGenerator")) {
     publishObject();
   }
   /// Withdraws the generator from other threads, finishes the queue (see

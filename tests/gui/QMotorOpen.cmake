@@ -1,0 +1,66 @@
+# -qmotor opens the QMotor window in the user's default browser (xdg-open) when there is a
+# display, and only prints its URL when there is none. A stand-in xdg-open on PATH records the URL
+# it is given; each run must also exit 0 without a shutdown.
+#   PROGRAM  a program that ends by itself (run with -qmotor -gui-port 0 -simclock)
+#   DIR      a scratch folder (emptied)
+file(REMOVE_RECURSE ${DIR})
+file(MAKE_DIRECTORY ${DIR}/bin ${DIR}/empty ${DIR}/work)
+file(WRITE ${DIR}/bin/xdg-open "#!/bin/sh\nprintf '%s\\n' \"$*\" >> '${DIR}/opened'\n")
+file(CHMOD ${DIR}/bin/xdg-open PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE)
+
+# Runs PROGRAM with the environment changes `env`; sets `out` to its output, checks the status.
+function(run_qmotor)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env ${ARGN} ${PROGRAM} -qmotor -gui-port 0 -simclock
+    WORKING_DIRECTORY ${DIR}/work RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e TIMEOUT 240)
+  message("${o}${e}")
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "exit status ${rc}, expected 0")
+  endif()
+  if("${o}${e}" MATCHES "rp: system shutdown")
+    message(FATAL_ERROR "the run ended in a system shutdown")
+  endif()
+  if(NOT "${o}${e}" MATCHES "rp: QMotor at (http://127\\.0\\.0\\.1:[0-9]+/qmotor\\.html[^\n]*)\n")
+    message(FATAL_ERROR "no QMotor URL printed")
+  endif()
+  set(url "${CMAKE_MATCH_1}" PARENT_SCOPE)
+  set(out "${o}${e}" PARENT_SCOPE)
+endfunction()
+
+# A display: the stand-in is started with the printed URL (it may finish after the program).
+run_qmotor(DISPLAY=:99 WAYLAND_DISPLAY= "PATH=${DIR}/bin:$ENV{PATH}")
+if(NOT out MATCHES "rp: -qmotor: opening it in the default browser \\(xdg-open\\)")
+  message(FATAL_ERROR "with a display the program does not say it opens the browser")
+endif()
+foreach(i RANGE 50)
+  if(EXISTS ${DIR}/opened)
+    break()
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} -E sleep 0.1)
+endforeach()
+if(NOT EXISTS ${DIR}/opened)
+  message(FATAL_ERROR "xdg-open was not started")
+endif()
+set(opened_url "${url}")
+file(READ ${DIR}/opened opened)
+if(NOT opened STREQUAL "${url}\n")
+  message(FATAL_ERROR "xdg-open was given '${opened}', expected the printed URL '${url}'")
+endif()
+file(REMOVE ${DIR}/opened)
+
+# No display: the URL only, and the program says why no browser opens.
+run_qmotor(--unset=DISPLAY --unset=WAYLAND_DISPLAY "PATH=${DIR}/bin:$ENV{PATH}")
+if(NOT out MATCHES "rp: -qmotor: no display \\(DISPLAY is not set\\): open the URL above in a browser")
+  message(FATAL_ERROR "without a display the program does not say so")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -E sleep 0.5)
+if(EXISTS ${DIR}/opened)
+  message(FATAL_ERROR "xdg-open was started without a display")
+endif()
+
+# A display but no xdg-open: the program says so and runs on.
+run_qmotor(DISPLAY=:99 "PATH=${DIR}/empty")
+if(NOT out MATCHES "rp: -qmotor: cannot start xdg-open \\([^)]+\\): open the URL above in a browser")
+  message(FATAL_ERROR "a missing xdg-open is not reported")
+endif()
+file(REMOVE_RECURSE ${DIR})
+message("-qmotor: xdg-open given ${opened_url}; no display and no xdg-open reported")
