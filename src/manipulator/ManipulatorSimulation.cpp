@@ -18,6 +18,10 @@ constexpr int kMaxFrictionSweeps = 200;  // coordinate-descent sweeps of the fri
 constexpr double kFrictionTolerance = 1e-13;  // [rad/s] largest change in the last sweep
 constexpr int kMaxStopSubsteps = 100;
 
+// Whether an external wrench acts: any component not zero, a NaN included (a wrench that is not
+// a number is not "no wrench": it makes the state non-finite, which the servo loop stops on).
+bool acts(const Vector<6>& wrench) { return !(wrench.array() == 0.0).all(); }
+
 // A model that keeps another's home position (ManipulatorModel::setHomePosition is protected).
 class PlantModel : public ManipulatorModel {
  public:
@@ -215,10 +219,10 @@ void ManipulatorSimulation::setExternalLinkWrench(int link, const Vector<3>& poi
                             " is not in 1.." + std::to_string(n));
   }
   const auto k = static_cast<std::size_t>(link - 1);
-  const bool was = linkWrench_[k].squaredNorm() > 0;
+  const bool was = acts(linkWrench_[k]);
   linkPoint_[k] = point;
   linkWrench_[k] = wrench;
-  linkWrenches_ += (wrench.squaredNorm() > 0 ? 1 : 0) - (was ? 1 : 0);
+  linkWrenches_ += (acts(wrench) ? 1 : 0) - (was ? 1 : 0);
 }
 
 void ManipulatorSimulation::clearExternalLinkWrenches() {
@@ -228,18 +232,18 @@ void ManipulatorSimulation::clearExternalLinkWrenches() {
 
 void ManipulatorSimulation::externalTorque() {
   tauExt_.setZero();
-  if (linkWrenches_ == 0 && !(wrench_.squaredNorm() > 0)) return;
+  if (linkWrenches_ == 0 && !acts(wrench_)) return;
   // One Jacobian J at the end-effector's origin e (it also computes the link frames). For a point
   // p moving with joints 1..k, column j <= k of its Jacobian is (Jv_j + Jw_j x (p - e), Jw_j), so
   // that column's torque is Jv_j . f + Jw_j . (m + (p - e) x f): the wrench moved to e.
   const Jacobian& J = jacobian(model_, data_, q_, ReferenceFrame::Base);
-  if (wrench_.squaredNorm() > 0) tauExt_.noalias() = J.transpose() * wrench_;
+  if (acts(wrench_)) tauExt_.noalias() = J.transpose() * wrench_;
   if (linkWrenches_ == 0) return;
   const Eigen::Vector3d e = data_.endEffector.topRightCorner<3, 1>();
   const int n = model_.getNumberOfJoints();
   for (int k = 0; k < n; ++k) {
     const Vector<6>& w = linkWrench_[static_cast<std::size_t>(k)];
-    if (!(w.squaredNorm() > 0)) continue;
+    if (!acts(w)) continue;
     const Transform& T = data_.linkTransforms[static_cast<std::size_t>(k)];
     const Eigen::Vector3d p =
         T.topLeftCorner<3, 3>() * Eigen::Vector3d(linkPoint_[static_cast<std::size_t>(k)]) + T.topRightCorner<3, 1>();
@@ -364,7 +368,10 @@ void ManipulatorSimulation::solveFriction(double h) {
       const double a = A_(i, i);
       const double p = a * qd_(i) - residual_(i);  // a times the coordinate's unconstrained minimiser
       double x = 0;
-      if (p > upper_(i)) {
+      if (!std::isfinite(p)) {
+        x = p;  // a force that is not finite (e.g. from the environment) is no friction problem:
+                // the state becomes non-finite, which the servo loop sees and stops on
+      } else if (p > upper_(i)) {
         x = (p - upper_(i)) / a;
       } else if (p < -lower_(i)) {
         x = (p + lower_(i)) / a;

@@ -1,9 +1,9 @@
-// What the servo loop does with faults: a torque that is not a number and an exception in a
-// user's servo control or trajectory generator shut the system down safely with the message; a
-// torque limit is a saturation (counted), not a fault; after a fault the damped hold really runs
-// until the arm is at rest (its stopping distance and time against an independent scalar model
-// of the joint), then the brakes engage; simulated brakes stop a moving joint with a finite
-// braking torque and hold an arm at rest under gravity.
+// What the servo loop does with faults: a torque or a joint reading that is not a number and an
+// exception in a user's servo control or trajectory generator shut the system down safely with
+// the message; a torque limit is a saturation (counted), not a fault; after a fault the damped
+// hold really runs until the arm is at rest (its stopping distance and time against an
+// independent scalar model of the joint), then the brakes engage; simulated brakes stop a moving
+// joint with a finite braking torque and hold an arm at rest under gravity.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -81,6 +81,33 @@ TEST_F(SafetyTest, ATorqueThatIsNotANumberShutsDownInTheSameCycle) {
               std::string::npos)
         << message;
     EXPECT_NE(ObjectManager::getShutdownReason().find("not a number"), std::string::npos);
+  }
+}
+
+// A joint reading that is not a number cannot be controlled (no damped hold can be computed from
+// it): the power goes off in that cycle, the brakes engage, and the system shuts down with the
+// joint named. Here the simulated environment goes bad: an infinite force, or one that is not a
+// number, on the end-effector turns the simulated joints into infinities and NaN (the plant never
+// takes such a force for none).
+TEST_F(SafetyTest, AJointReadingThatIsNotANumberPowersOffAtOnce) {
+  for (double bad : {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    ObjectManager::resetShutdown();
+    Puma560 puma;
+    ASSERT_TRUE(puma.waitForCycles(5, 10));
+    ASSERT_TRUE(puma.isArmPowerOn());
+    Vector<6> wrench;
+    wrench(0) = bad;
+    puma.applyExternalWrench(wrench);
+    ASSERT_TRUE(ObjectManager::waitForShutdown(10)) << "force " << bad;
+    for (int i = 0; i < 10000 && !puma.isShutdownComplete(); ++i) puma.waitForCycles(1, 1);
+    EXPECT_TRUE(puma.isShutdownComplete());
+    EXPECT_FALSE(puma.isArmPowerOn());
+    EXPECT_EQ(puma.getErrorCode(), 2);
+    const std::string message = puma.getErrorStatus().message;
+    EXPECT_NE(message.find("reading is not a number"), std::string::npos) << message;
+    EXPECT_NE(ObjectManager::getShutdownReason().find("reading is not a number"), std::string::npos)
+        << ObjectManager::getShutdownReason();
+    EXPECT_TRUE(puma.getControlOutput().isZero()) << "no torque is sent after a reading that is not a number";
   }
 }
 
