@@ -66,6 +66,18 @@ canvas.addEventListener('pointerup', (ev) => {
 });
 document.getElementById('new-view').href = location.href;
 document.getElementById('qmotor-link').href = `qmotor.html${location.search}`;
+document.getElementById('reset-view').addEventListener('click', () => view.resetView());
+document.getElementById('show-frames').addEventListener('change', (ev) => view.showFrames(ev.target.checked));
+// The end-effector pose of each manipulator, in millimetres and degrees (a few times a second).
+const readout = document.getElementById('ee-readout');
+setInterval(() => {
+  const f = (x, w) => x.toFixed(1).padStart(w);
+  const text = view.endEffectorPoses().map((e) =>
+    `${e.name}  x ${f(e.position[0], 7)}  y ${f(e.position[1], 7)}  z ${f(e.position[2], 7)} mm   ` +
+    `roll ${f(e.rpy[0], 6)}  pitch ${f(e.rpy[1], 6)}  yaw ${f(e.rpy[2], 6)} deg`).join('\n');
+  if (readout.textContent !== text) readout.textContent = text;
+  readout.hidden = text === '';
+}, 200);
 document.getElementById('toggle-list').addEventListener('click', () =>
   document.getElementById('list-window').classList.toggle('hidden'));
 

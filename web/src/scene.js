@@ -1,6 +1,7 @@
 // The 3D view: one group per object, one group per object frame (posed from the state frames),
 // the object's shapes in its frames, links drawn between consecutive frames of a manipulator,
-// gripper fingers that follow the gripper's state; OrbitControls for the mouse.
+// gripper fingers that follow the gripper's state; OrbitControls for the mouse (the camera stays
+// above the floor), a reset of the view, each frame's axes on demand, and the end-effector poses.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { STLLoader } from 'three/examples/jsm/loaders/STLLoader.js';
@@ -111,7 +112,18 @@ export class SceneView {
     this.camera.position.set(2.2, -1.8, 1.6);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.target.set(0, 0, 0.5);
+    // The camera stays above the floor (z = 0): it never looks up from below the target, and the
+    // target is never panned below the floor.
+    this.controls.maxPolarAngle = Math.PI / 2 - 0.02;
+    this.controls.addEventListener('change', () => {
+      if (this.controls.target.z < 0) {
+        this.camera.position.z -= this.controls.target.z;
+        this.controls.target.z = 0;
+      }
+    });
     this.controls.update();
+    this.defaultDirection = this.camera.position.clone().sub(this.controls.target).normalize();
+    this.framesShown = false;
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x667788, 1.2));
     const sun = new THREE.DirectionalLight(0xffffff, 1.5);
     sun.position.set(3, -2, 5);
@@ -235,6 +247,43 @@ export class SceneView {
     return true;
   }
 
+  // Back to the view the page opened with: the default direction, framing every object drawn
+  // (and framing again as meshes arrive, until the user moves the view).
+  resetView() {
+    this.camera.position.copy(this.controls.target).add(this.defaultDirection);
+    this.userMoved = false;
+    this.refit = false;
+    if (!this.fitView()) this.controls.update();
+  }
+
+  // Shows or hides the axes of every frame of every object (x red, y green, z blue).
+  showFrames(on) {
+    this.framesShown = on;
+    for (const o of this.objects.values()) for (const a of o.axes) a.visible = on;
+  }
+
+  // The world pose of each manipulator's end-effector frame: { name, position [mm], rpy [deg] }
+  // (roll, pitch and yaw about the fixed x, y and z axes, as rp::transformToRPY gives them).
+  endEffectorPoses() {
+    const out = [];
+    const m = new THREE.Matrix4();
+    const p = new THREE.Vector3();
+    const q = new THREE.Quaternion();
+    const scale = new THREE.Vector3();
+    const e = new THREE.Euler();
+    for (const o of this.objects.values()) {
+      if (o.desc.kind !== 'manipulator') continue;
+      const frame = o.frames.find((f) => f.name === 'endEffector');
+      if (!frame) continue;
+      frame.updateWorldMatrix(true, false);
+      m.copy(frame.matrixWorld).decompose(p, q, scale);
+      e.setFromQuaternion(q, 'ZYX'); // R = Rz(yaw) Ry(pitch) Rx(roll)
+      out.push({ name: o.desc.name, position: p.toArray().map((x) => x * 1000),
+        rpy: [e.x, e.y, e.z].map((x) => THREE.MathUtils.radToDeg(x)) });
+    }
+    return out;
+  }
+
   // For tests and the console (read only): what is drawn for each shape of object `name`: kind,
   // URDF link, frame, state ('primitive', 'loading', 'mesh', 'fallback', 'placeholder'), error,
   // texture (null: none; 'loading', 'drawn', 'failed'), and the world-space bounding box of what
@@ -270,6 +319,16 @@ export class SceneView {
       return g;
     });
     const frameByName = new Map(frames.map((g) => [g.name, g]));
+    // Each frame's axes, shown on demand (showFrames()); not pickable.
+    const axes = frames.map((g) => {
+      const a = new THREE.AxesHelper(desc.kind === 'manipulator' ? 0.12 : 0.08);
+      a.visible = this.framesShown;
+      a.raycast = () => {};
+      a.material.depthTest = false; // drawn over the links they sit in
+      a.renderOrder = 1;
+      g.add(a);
+      return a;
+    });
     // Per shape, what is drawn for it: state 'primitive', 'loading', 'mesh', 'fallback' (the
     // link's collision geometry) or 'placeholder', with the three.js objects and any error.
     const drawn = [];
@@ -375,7 +434,7 @@ export class SceneView {
       }
     });
     if (desc.urdfError) problems.push({ frame: 'base', text: `URDF visuals: ${desc.urdfError}` });
-    const o = { root, frames, desc, key, materials, bones: [], fingers: null, drawn, problems, label: null };
+    const o = { root, frames, axes, desc, key, materials, bones: [], fingers: null, drawn, problems, label: null };
     if (desc.kind === 'manipulator' && !desc.urdfVisuals) { // a URDF arm is drawn by its own visuals
       const linkMat = material([0.55, 0.6, 0.7, 1]);
       for (let i = 0; i + 1 < frames.length; ++i) {
