@@ -195,6 +195,8 @@ json SceneState::describe(Entry& e) {
       m.shapes.clear();  // the URDF's own look instead of the generic links
       for (const UrdfVisual& v : e.urdfVisuals) m.shapes.push_back(v.shape);
       j["urdfVisuals"] = true;
+    } else if (m.linksDrawn) {
+      j["linksDrawn"] = true;  // the object's shapes draw its links (no generic links between frames)
     }
     if (!e.urdfError.empty()) j["urdfError"] = e.urdfError;
     e.frames = m.frames;

@@ -17,6 +17,7 @@
 #include "rp/model/Kinematics.hpp"
 #include "rp/rt/Clock.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
+#include "LinkShapes.hpp"
 
 namespace rp {
 
@@ -875,6 +876,12 @@ Model3D DefaultManipulator::get3DModel() const {
   const int n = initial_.n;
   for (int i = 1; i <= n; ++i) m.frames.push_back("link" + std::to_string(i));
   m.frames.push_back("endEffector");
+  // The links as the kinematics place them (a Puma 560 and a WAM look like themselves); an arm
+  // with mimic joints is drawn as frames the viewer links (its chain has frames of its own).
+  if (const ManipulatorModel& model = getModel(); !model.hasMimicJoints() && model.getNumberOfJoints() == n) {
+    internal::addLinkShapes(model, m);
+    return m;
+  }
   Shape base;
   base.kind = ShapeKind::Cylinder;
   base.size = Vector<3>{{0.1}, {0.2}, {0}};

@@ -1,5 +1,5 @@
-// Browser test of the Scene Viewer's view controls on rp-jointmove's Puma 560: the end-effector
-// pose readout (against the Robotics Toolbox's fkine(qr), and after joint 1 turns), each frame's
+// Browser test of the Scene Viewer's view controls on rp-jointmove's Puma 560 (drawn with its
+// model's link shapes): the end-effector pose readout (against the Robotics Toolbox's fkine(qr), and after joint 1 turns), each frame's
 // axes on demand, the camera kept above the floor while the user drags, and Reset view.
 import { describe, it } from 'node:test';
 import assert from 'node:assert/strict';
@@ -48,6 +48,14 @@ describe('Scene Viewer view controls on rp-jointmove', () => {
     // fkine(qr) = [0.0203, -0.15005, 1.53543] m with R = I (shared/refdata, 02_puma560).
     const r = await readout(page);
     assert.ok(r, 'no readout line for the Puma');
+    // The Puma's links are drawn by its model's shapes (DH offsets, motor housings), not as
+    // generic cylinders between its frames.
+    const look = await page.evaluate(() => {
+      const o = window.rp.view.objects.get('puma');
+      return { linksDrawn: o.desc.linksDrawn, bones: o.bones.length, shapes: o.drawn.length };
+    });
+    assert.deepEqual({ linksDrawn: look.linksDrawn, bones: look.bones }, { linksDrawn: true, bones: 0 });
+    assert.ok(look.shapes >= 12, `${look.shapes} shapes`);
     const expected = [20.3, -150.05, 1535.43];
     for (let i = 0; i < 3; ++i) assert.ok(Math.abs(r.p[i] - expected[i]) < 0.2, `position ${JSON.stringify(r.p)}`);
     for (let i = 0; i < 3; ++i) assert.ok(Math.abs(r.rpy[i]) < 0.1, `orientation ${JSON.stringify(r.rpy)}`);

@@ -435,7 +435,9 @@ export class SceneView {
     });
     if (desc.urdfError) problems.push({ frame: 'base', text: `URDF visuals: ${desc.urdfError}` });
     const o = { root, frames, axes, desc, key, materials, bones: [], fingers: null, drawn, problems, label: null };
-    if (desc.kind === 'manipulator' && !desc.urdfVisuals) { // a URDF arm is drawn by its own visuals
+    // A URDF arm is drawn by its own visuals, a DH arm by the links its model draws; other arms
+    // get a cylinder between consecutive frames.
+    if (desc.kind === 'manipulator' && !desc.urdfVisuals && !desc.linksDrawn) {
       const linkMat = material([0.55, 0.6, 0.7, 1]);
       for (let i = 0; i + 1 < frames.length; ++i) {
         const bone = new THREE.Mesh(unitCylinder, linkMat);

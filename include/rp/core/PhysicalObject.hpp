@@ -49,6 +49,8 @@ struct Shape {
 struct Model3D {
   std::vector<std::string> frames{"base"};  ///< the object's frames; "base" is its own pose
   std::vector<Shape> shapes;                ///< shapes, each attached to one of `frames`
+  /// A manipulator's shapes draw its links: the viewer adds no generic links between its frames.
+  bool linksDrawn = false;
 };
 
 /// Base class of manipulators, grippers, sensors and every other physical object: 3D model,
