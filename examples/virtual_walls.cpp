@@ -22,6 +22,8 @@
 //    kf = 0.01 N/m is too soft to feel. Here the wall is the plane x = 0.4 m, (-1, 0, 0, 0.4),
 //    with kf = 2000 N/m (a 20 N push goes 1 cm into the wall).
 // 6. `override` on calculate() and `std::` where needed; the class is unchanged otherwise.
+// 7. The wall is drawn in the Scene Viewer: a `Wall` object, a thin box on the plane, on the side
+//    the arm must stay out of (not in the paper).
 #include "RoboticPlatform.hpp"
 
 #include <chrono>
@@ -60,6 +62,43 @@ class VirtualWallServoControl : public ServoControl  // (1)
   double d_kf;
 };
 
+// ----- The wall, as the Scene Viewer draws it (7) -----
+
+class Wall : public PhysicalObject {
+ public:
+  // The plane n . x + d0 = 0, drawn as a box `thickness` deep behind it (where
+  // n . x + d0 < 0), `width` by `height` about the point of the plane nearest to (0, 0, 1 m).
+  Wall(const std::string& name, const Vector<4>& w, double width = 1.6, double height = 1.6, double thickness = 0.02)
+      : PhysicalObject(name), w_(w), size_{{thickness}, {width}, {height}} {
+    publishObject();  // complete: the Scene Viewer may draw it
+  }
+  ~Wall() override { withdrawObject(); }
+  Model3D get3DModel() const override {
+    const Vector<3> normal = w_.getSubMatrix<3, 1>(1, 1);
+    const Vector<3> n = normal / normal.norm();
+    const Vector<3> up{{0.0}, {0.0}, {1.0}};
+    const Vector<3> onPlane = up - ((dotProduct(normal, up) + w_(3)) / normal.norm()) * n;  // nearest to (0, 0, 1)
+    Shape box;
+    box.kind = ShapeKind::Box;
+    // The box's x axis along -n (into the wall), its centre half a thickness behind the plane.
+    const Vector<3> x = -n;
+    const Vector<3> y = std::abs(x(2)) < 0.9 ? Vector<3>(crossProduct(up, x)) : Vector<3>{{0.0}, {1.0}, {0.0}};
+    const Vector<3> z = crossProduct(x, y);
+    Matrix<3, 3> r;
+    for (int i = 0; i < 3; ++i) r(i, 0) = x(i), r(i, 1) = y(i) / y.norm(), r(i, 2) = z(i) / z.norm();
+    box.pose = makeTransform(r, onPlane + 0.5 * size_(0) * x);
+    box.size = size_;
+    box.color = Color{0.55, 0.75, 0.95, 1.0};
+    Model3D m;
+    m.shapes.push_back(box);
+    return m;
+  }
+
+ private:
+  Vector<4> w_;
+  Vector<3> size_;
+};
+
 // ----- Use the virtual walls servo control -----
 
 int main(int argc, char* argv[]) {
@@ -90,6 +129,7 @@ int main(int argc, char* argv[]) {
   VirtualWallServoControl<6> wallControl;  // (2)
   wallControl.d_kf = 2000;
   wallControl.d_wallCoefficients = -1, 0, 0, 0.4;
+  Wall wall("wall", wallControl.d_wallCoefficients);  // (7)
 
   puma.setGravityCompensationOn();  // (3)
   puma.setServoControl(wallControl);

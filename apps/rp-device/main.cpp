@@ -9,6 +9,7 @@
 // Exit status: 0 done; 1 device error (the object's error status is printed); 2 configuration
 // or usage error (bad switch, bad rp.cfg, unknown object, unknown command).
 #include <iostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -106,9 +107,20 @@ int main(int argc, char** argv) {
                   << "' (commands: " << commandList(*object) << "; or read)\n";
         status = 2;
       } else {
-        object->executeCommand(command);
-        if (object->getErrorCode() != 0) status = deviceError(*object);
-        else std::cout << name << ": " << command << " done" << std::endl;
+        std::string failure;
+        try {
+          object->executeCommand(command);
+        } catch (const std::runtime_error& e) {
+          failure = e.what();  // the device did not carry it out
+        }
+        if (object->getErrorCode() != 0) {
+          status = deviceError(*object);
+        } else if (!failure.empty()) {
+          std::cerr << "rp-device: " << namedMessage(*object, failure) << std::endl;
+          status = 1;
+        } else {
+          std::cout << name << ": " << command << " done" << std::endl;
+        }
       }
     }
   } catch (const rp::ConfigError& e) {

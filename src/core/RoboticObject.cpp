@@ -77,7 +77,7 @@ struct RoboticObject::Impl {
   std::mutex commandMutex;
   struct Command {
     std::string name, description;
-    std::function<void()> action;
+    std::function<std::string()> action;
   };
   std::vector<Command> commands;
 };
@@ -156,6 +156,16 @@ ErrorStatus RoboticObject::getErrorStatus() const {
 }
 
 void RoboticObject::addCommand(const std::string& name, std::function<void()> action, const std::string& description) {
+  if (!action) throw std::invalid_argument("addCommand: no action for '" + name + "' of " + getName());
+  addCommandWithResult(name, [action = std::move(action)] {
+    action();
+    return std::string("done");
+  }, description);
+}
+
+void RoboticObject::addCommandWithResult(const std::string& name, std::function<std::string()> action,
+                                         const std::string& description) {
+  if (!action) throw std::invalid_argument("addCommand: no action for '" + name + "' of " + getName());
   std::lock_guard<std::mutex> lock(impl_->commandMutex);
   for (const auto& c : impl_->commands)
     if (c.name == name) throw std::invalid_argument("addCommand: '" + name + "' is already a command of " + getName());
@@ -169,8 +179,15 @@ std::vector<CommandInfo> RoboticObject::getCommands() const {
   return out;
 }
 
-void RoboticObject::executeCommand(const std::string& name) {
-  std::function<void()> action;
+std::string RoboticObject::commandResult(bool ok, const std::string& done) const {
+  if (ok) return done;
+  const ErrorStatus status = getErrorStatus();
+  throw std::runtime_error(status.message.empty() ? getName() + ": the device did not carry the command out"
+                                                  : status.message);
+}
+
+std::string RoboticObject::executeCommand(const std::string& name) {
+  std::function<std::string()> action;
   {
     std::lock_guard<std::mutex> lock(impl_->commandMutex);
     std::string known;
@@ -182,7 +199,7 @@ void RoboticObject::executeCommand(const std::string& name) {
       throw std::invalid_argument("executeCommand: " + getName() + " has no command '" + name +
                                   "' (known: " + (known.empty() ? "none" : known) + ")");
   }
-  action();
+  return action();
 }
 
 void RoboticObject::startShutdown() {

@@ -35,7 +35,8 @@ BarrettHand::BarrettHand(const std::string& name) : Gripper(ClassSection(name, "
   } else {
     driver_ = std::make_unique<BarrettHandSerial>(config_);
   }
-  addCommand("Initialize", [this] { initialize(); }, "initialise the hand (HI)");
+  addCommandWithResult("Initialize", [this] { return commandResult(initialize(), "initialised"); },
+                       "initialise the hand (HI)");
   publishObject();  // complete: other threads (the Scene Viewer) may use it
 }
 

@@ -33,7 +33,8 @@ ForceTorqueSensor::ForceTorqueSensor(const std::string& name) : PhysicalObject(n
     }
     if (section->has("updateRate")) updateRate_ = section->getNumbers("updateRate").at(0);
   }
-  addCommand("Bias", [this] { bias(); }, "take the current load as zero");
+  addCommandWithResult("Bias", [this] { return commandResult(bias(), "the current load is zero now"); },
+                       "take the current load as zero");
   // The library drives update(): a thread of the sensor's own, started by the most-derived
   // constructor's startControlLoop() (RoboticObject's additional threads).
   if (updateRate_ > 0) addPeriodicThread("ft-update", 1.0 / updateRate_, [this] { update(); });

@@ -4,6 +4,7 @@
 #include <limits>
 #include <mutex>
 #include <sstream>
+#include <string>
 
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/TypeDatabase.hpp"
@@ -28,9 +29,10 @@ Gripper::Gripper(const std::string& name) : PhysicalObject(name), impl_(std::mak
     }
     if (const ConfigSetting* s = section->find("graspable")) impl_->graspableNames = s->values;
   }
-  addCommand("Open", [this] { open(); }, "open the gripper");
-  addCommand("Close", [this] { close(); }, "close the gripper");
-  addCommand("Relax", [this] { relax(); }, "relax the gripper (no force)");
+  // A command the device did not carry out says why (the error status its driver set).
+  addCommandWithResult("Open", [this] { return commandResult(open(), "open"); }, "open the gripper");
+  addCommandWithResult("Close", [this] { return commandResult(close(), "closed"); }, "close the gripper");
+  addCommandWithResult("Relax", [this] { return commandResult(relax(), "relaxed"); }, "relax the gripper (no force)");
 }
 
 Gripper::~Gripper() = default;

@@ -5,9 +5,10 @@
 namespace rp {
 
 ToolChanger::ToolChanger(const std::string& name) : PhysicalObject(name) {
-  addCommand("Lock", [this] { lock(); }, "lock the tool");
-  addCommand("Unlock", [this] { unlock(); }, "release the tool");
-  addCommand("Relax", [this] { relax(); }, "switch both actuators off");
+  // A command the device did not carry out says why (the error status its driver set).
+  addCommandWithResult("Lock", [this] { return commandResult(lock(), "locked"); }, "lock the tool");
+  addCommandWithResult("Unlock", [this] { return commandResult(unlock(), "unlocked"); }, "release the tool");
+  addCommandWithResult("Relax", [this] { return commandResult(relax(), "relaxed"); }, "switch both actuators off");
 }
 
 ToolChanger::~ToolChanger() = default;

@@ -264,6 +264,9 @@ json SceneState::describe(Entry& e) {
     json names = json::array();  // a URDF arm's own joint names; joint1, joint2, ... otherwise
     for (int i = 0; i < model.getNumberOfJoints(); ++i) names.push_back(model.getJointName(i));
     j["jointNames"] = names;
+    json prismatic = json::array();  // the panels show revolute joints in degrees, prismatic ones in mm
+    for (int i = 0; i < model.getNumberOfJoints(); ++i) prismatic.push_back(model.isPrismatic(i));
+    j["prismatic"] = prismatic;
     j["qmin"] = vectorJson(model.getPositionMin());
     j["qmax"] = vectorJson(model.getPositionMax());
     j["vmax"] = vectorJson(model.getVelocityLimit());

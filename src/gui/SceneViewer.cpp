@@ -799,8 +799,7 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     if (!str("command", command)) return;
     action = [object, command] {
       ObjectReference o = publishedObject(object);
-      o->executeCommand(command);
-      return std::string();
+      return o->executeCommand(command);  // what it did, shown in the page
     };
   } else if (type == "display") {
     std::string mode;

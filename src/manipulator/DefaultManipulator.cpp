@@ -304,6 +304,48 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   if (const ConfigSection* section = configSection(); section != nullptr && section->qmotorConfig() != nullptr) {
     applyQMotorConfig(*section->qmotorConfig());
   }
+  addOperatorCommands();
+}
+
+void DefaultManipulator::addOperatorCommands() {
+  // The pop-up menu's and the control panel's commands (paper Figures 17 and 18): each says what
+  // it did, or throws saying why it cannot be done.
+  addCommandWithResult("Power On", [this] {
+    // A generator's setpoint moved on while the arm stood braked: powering on would pull the arm
+    // there at once. Its program powers the arm, or the generator is released first.
+    if (generator_.load() != nullptr)
+      throw std::logic_error("a trajectory generator drives the arm: its program powers it on (or release the generator first)");
+    enableArmPower();  // refused during a shutdown, or without hardware and simulation
+    return std::string("arm power on: the arm holds where it is");
+  }, "switch the amplifiers on; the arm holds where it is");
+  addCommandWithResult("Power Off", [this] {
+    disableArmPower();
+    return std::string("arm power off: brakes on");
+  }, "switch the amplifiers off and engage the brakes");
+  addCommandWithResult("Gravity Compensation On", [this] {
+    setGravityCompensationOn();
+    return std::string("gravity compensation on");
+  }, "add the model's gravity torques to the servo control's command");
+  addCommandWithResult("Gravity Compensation Off", [this] {
+    setGravityCompensationOff();
+    return std::string("gravity compensation off");
+  }, "the servo control alone holds the arm against gravity");
+  addCommandWithResult("Zero Gravity On", [this] {
+    if (shutdownPhase_.load() != 0) throw std::logic_error("not during a shutdown");
+    setZeroGravityModeOn();
+    return std::string("zero-gravity mode on: the arm floats and stays where it is pushed");
+  }, "gravity compensation only: the arm can be moved by hand");
+  addCommandWithResult("Zero Gravity Off", [this] {
+    setZeroGravityModeOff();
+    return std::string("zero-gravity mode off: the arm holds where it is");
+  }, "the servo control takes over where the arm is");
+  addCommandWithResult("Hold Here", [this] {
+    if (generator_.load() != nullptr)
+      throw std::logic_error("a trajectory generator drives the arm: its program holds or moves it (release the generator first)");
+    setZeroGravityModeOff();
+    holdHere_.store(true);
+    return std::string("holding the arm where it is");
+  }, "hold the arm at its present position");
 }
 
 DefaultManipulator::~DefaultManipulator() {

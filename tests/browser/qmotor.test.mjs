@@ -1,7 +1,8 @@
 // Browser test of the QMotor window (-qmotor): its URL is printed, a plot receives samples of the
-// arm's joint positions, and the tunable parameters are there; with -log FILE a log variable picked
-// from the list of the program's log columns is plotted live, and Stop/Start logging leave a gap
-// in the log file; bad log requests are refused.
+// arm's joint positions, and the tunable parameters are there; the plot pauses, zooms and pans
+// without the next frames undoing it, reads the values under the cursor and exports a PNG; with
+// -log FILE a log variable picked from the list of the program's log columns is plotted live, and
+// Stop/Start logging leave a gap in the log file; bad log requests are refused.
 import { describe, it, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
@@ -113,5 +114,79 @@ describe('QMotor log variables on work_cell -log FILE -qmotor', () => {
     assert.ok(times.some((t) => t < tStop), 'no rows before the stop');
     assert.ok(times.some((t) => t > tStart + 0.3), 'no rows after the start');
     assert.ok(times.filter((t) => t <= tStop).length > 300, 'too few rows before the stop');
+  });
+});
+
+describe('QMotor plot controls on work_cell -qmotor', () => {
+  const ctx = withProgram('work_cell', ['-gui-port', '0', '-qmotor', '--arm-only']);
+
+  it('pause, zoom and pan that the next frames do not undo, a cursor readout, Live, and a PNG export', async () => {
+    const url = ctx.program.output().match(/rp: QMotor at (\S+)/)[1];
+    const page = await openViewer(ctx.browser, `${url}?object=puma`, { width: 1100, height: 700 });
+    await page.waitForSelector('#plot .u-over');
+    await waitInPage(page, () => window.rp.samples > 60);
+    const shown = () => page.evaluate(() => {
+      const p = window.rp.plot;
+      return { last: p.data[0][p.data[0].length - 1], min: p.scales.x.min, max: p.scales.x.max };
+    });
+    // Pause: samples keep coming, the plot keeps what it showed.
+    await page.click('#plot-pause');
+    const paused = await shown();
+    const n0 = await page.evaluate(() => window.rp.samples);
+    await waitInPage(page, (n) => window.rp.samples > n + 30, n0);
+    assert.deepEqual(await shown(), paused, 'the paused plot changed');
+    assert.equal(await page.textContent('#plot-mode'), 'paused');
+    // Live: the plot follows the samples again.
+    await page.click('#plot-live');
+    await waitInPage(page, (t) => {
+      const d = window.rp.plot.data[0];
+      return d[d.length - 1] > t + 0.2;
+    }, paused.last);
+    // A drag over the plot zooms in on that span and keeps it while frames arrive.
+    const over = await page.locator('#plot .u-over').boundingBox();
+    const before = await shown();
+    await page.mouse.move(over.x + over.width * 0.3, over.y + over.height / 2);
+    await page.mouse.down();
+    await page.mouse.move(over.x + over.width * 0.6, over.y + over.height / 2, { steps: 5 });
+    await page.mouse.up();
+    await waitInPage(page, () => window.rp.frozen);
+    const zoomed = await shown();
+    assert.equal(await page.textContent('#plot-mode'), 'zoomed');
+    const n1 = await page.evaluate(() => window.rp.samples);
+    await waitInPage(page, (n) => window.rp.samples > n + 30, n1);
+    assert.deepEqual(await shown(), zoomed, 'the next frames undid the zoom');
+    // The drag covered 30 % of the width: the span shown is about 30 % of the span before.
+    const share = (zoomed.max - zoomed.min) / (before.max - before.min);
+    assert.ok(share > 0.2 && share < 0.4, `zoom ${JSON.stringify(zoomed)}, before ${JSON.stringify(before)}`);
+    // The wheel pans the span by a tenth of its width.
+    await page.mouse.move(over.x + over.width / 2, over.y + over.height / 2);
+    await page.mouse.wheel(0, -100);
+    const panned = await waitInPage(page, (z) => {
+      const x = window.rp.plot.scales.x;
+      return x.min !== z.min ? { min: x.min, max: x.max } : false;
+    }, zoomed);
+    const width = zoomed.max - zoomed.min;
+    assert.ok(Math.abs((panned.max - panned.min) - width) < 1e-9 * Math.max(1, width), 'panning changed the span');
+    assert.ok(Math.abs(Math.abs(panned.min - zoomed.min) - 0.1 * width) < 1e-9 * Math.max(1, width), JSON.stringify(panned));
+    // The cursor reads the plotted values at the sample under it.
+    await page.mouse.move(over.x + over.width / 2, over.y + over.height / 2);
+    const c = await waitInPage(page, () => window.rp.cursor);
+    const at = await page.evaluate((t) => {
+      const p = window.rp.plot;
+      const i = p.data[0].indexOf(t);
+      return { i, q0: p.data[1][i] };
+    }, c.t);
+    assert.ok(at.i >= 0, 'the cursor time is not a sample time');
+    assert.equal(c.values['q[0]'], at.q0);
+    assert.match(await page.textContent('#plot-cursor'), /^t [0-9.]+ s: q\[0\] /);
+    // Export PNG: a PNG file of the plot.
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#plot-png')]);
+    assert.match(download.suggestedFilename(), /^qmotor-puma-.*\.png$/);
+    const path = await download.path();
+    const png = readFileSync(path);
+    assert.deepEqual([...png.subarray(0, 8)], [0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a], 'not a PNG file');
+    assert.ok(png.length > 2000, `${png.length} bytes`);
+    assert.deepEqual(page.rpErrors, []);
+    await page.close();
   });
 });

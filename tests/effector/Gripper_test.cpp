@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "EffectorTestSupport.hpp"
 #include "ModbusEmulator.hpp"
@@ -123,6 +124,27 @@ TEST_F(GripperTest, ModbusGripperSetsCoilsAndReportsADeadDevice) {
   EXPECT_EQ(g->getState(), Gripper::State::Open) << "state unchanged by a failed command";
   EXPECT_EQ(g->getErrorCode(), 1);
   EXPECT_TRUE(contains(g->getErrorStatus().message, "gripper: ModbusIoBoard 127.0.0.1:")) << g->getErrorStatus().message;
+}
+
+TEST_F(GripperTest, ACommandSaysWhatItDidOrWhyTheDeviceDidNot) {
+  // What the pop-up menu shows: the command's result, or the driver's reason when the device did
+  // not carry it out (never "done" for a close that did not happen).
+  emulator::ModbusEmulator device;
+  device.start();
+  configure("[gripper]\nclass DefaultGripper\nsimulationMode off\nboard modbus\naddress 127.0.0.1\nport " +
+            std::to_string(device.port()) + "\ntimeout 1000\nopenLine 6\ncloseLine 7\n");
+  auto* g = om_.createDerivedObject<Gripper>("gripper");
+  EXPECT_EQ(g->executeCommand("Close"), "closed");
+  EXPECT_TRUE(device.coil(7));
+  EXPECT_EQ(g->executeCommand("Open"), "open");
+  device.stop();
+  try {
+    g->executeCommand("Close");
+    FAIL() << "a close the device did not carry out was reported as done";
+  } catch (const std::runtime_error& e) {
+    EXPECT_TRUE(contains(e.what(), "gripper: ModbusIoBoard 127.0.0.1:")) << e.what();
+  }
+  EXPECT_EQ(g->getState(), Gripper::State::Open);
 }
 
 TEST_F(GripperTest, HardwareServerThatIsNotRunningIsADeviceError) {

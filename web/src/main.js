@@ -1,7 +1,7 @@
 // The Scene Viewer page: 3D view, Object List, pop-up menus and control panels.
 import './style.css';
 import { Connection } from './connection.js';
-import { notify, showStatus } from './ui.js';
+import { inform, notify, showStatus } from './ui.js';
 import { SceneView } from './scene.js';
 import { ObjectList, PopupMenu, ControlPanel } from './panels.js';
 
@@ -41,7 +41,7 @@ const conn = new Connection({
   onError: notify,
 });
 view.onMeshFailed = (object, shape, message) => conn.meshFailed(object, shape, message).catch(() => {});
-const menu = new PopupMenu(conn, openPanel, notify);
+const menu = new PopupMenu(conn, openPanel, notify, inform);
 const showMenu = (name, x, y) => {
   const desc = scene && scene.objects.find((o) => o.name === name);
   if (desc) menu.show(desc, x, y);
@@ -72,7 +72,9 @@ document.getElementById('show-frames').addEventListener('change', (ev) => view.s
 const readout = document.getElementById('ee-readout');
 setInterval(() => {
   const f = (x, w) => x.toFixed(1).padStart(w);
-  const text = view.endEffectorPoses().map((e) =>
+  const poses = view.endEffectorPoses();
+  for (const e of poses) if (panels.has(e.name)) panels.get(e.name).setEndEffector(e);
+  const text = poses.map((e) =>
     `${e.name}  x ${f(e.position[0], 7)}  y ${f(e.position[1], 7)}  z ${f(e.position[2], 7)} mm   ` +
     `roll ${f(e.rpy[0], 6)}  pitch ${f(e.rpy[1], 6)}  yaw ${f(e.rpy[2], 6)} deg`).join('\n');
   if (readout.textContent !== text) readout.textContent = text;

@@ -34,10 +34,11 @@ export class ObjectList {
 }
 
 export class PopupMenu {
-  constructor(conn, openPanel, notify) {
+  constructor(conn, openPanel, notify, inform) {
     this.conn = conn;
     this.openPanel = openPanel;
     this.notify = notify;
+    this.inform = inform;
     this.menu = el('div', { id: 'popup-menu', class: 'popup hidden' });
     document.body.append(this.menu);
     document.addEventListener('click', () => this.hide());
@@ -49,16 +50,20 @@ export class PopupMenu {
   show(desc, x, y) {
     const item = (label, action) =>
       el('div', { class: 'item', 'data-action': label, onclick: (ev) => { ev.stopPropagation(); this.hide(); action(); } }, label);
-    const run = (p) => p.then(() => {}).catch((e) => this.notify(`${desc.name}: ${e.message}`));
+    // A command's result (or why it was refused) is shown in the page.
+    const run = (p, what) => p.then((r) => {
+      if (what) this.inform(`${desc.name}: ${what}: ${(r && r.reply) || 'done'}`);
+    }, (e) => this.notify(`${desc.name}: ${what ? `${what}: ` : ''}${e.message}`));
     const items = [el('div', { class: 'title' }, `${desc.name} (${desc.published === false ? 'not published' : desc.className})`)];
     if (desc.physical) {
-      items.push(item(desc.display === 'off' ? 'Show' : 'Hide', () => run(this.conn.display(desc.name, desc.display === 'off' ? 'solid' : 'off'))));
-      items.push(item('Solid', () => run(this.conn.display(desc.name, 'solid'))));
-      items.push(item('Wireframe', () => run(this.conn.display(desc.name, 'wireframe'))));
+      const display = (mode) => run(this.conn.display(desc.name, mode), null);
+      items.push(item(desc.display === 'off' ? 'Show' : 'Hide', () => display(desc.display === 'off' ? 'solid' : 'off')));
+      items.push(item('Solid', () => display('solid')));
+      items.push(item('Wireframe', () => display('wireframe')));
     }
     if (desc.commands.length) items.push(el('div', { class: 'sep' }));
     for (const c of desc.commands) {
-      const i = item(c.name, () => run(this.conn.command(desc.name, c.name)));
+      const i = item(c.name, () => run(this.conn.command(desc.name, c.name), c.name));
       i.title = c.description;
       items.push(i);
     }
@@ -79,10 +84,14 @@ export class ControlPanel {
     this.notify = notify;
     this.body = el('div', { class: 'panel-body' });
     this.status = el('div', { class: 'panel-status' });
+    // The object's commands as buttons; the last one's result, or why it was refused.
+    this.commands = el('div', { class: 'panel-commands' });
+    this.result = el('div', { class: 'panel-result hidden' });
+    this.endEffector = null;
     this.title = el('span', {}, name);
     this.win = el('div', { class: 'window panel', 'data-panel': name },
       el('div', { class: 'window-title' }, this.title, el('button', { class: 'close', onclick: () => onClose(this) }, '×')),
-      this.status, this.body);
+      this.status, this.commands, this.result, this.body);
     document.getElementById('panels').append(this.win);
     this.cells = [];
   }
@@ -99,6 +108,7 @@ export class ControlPanel {
     // the one being edited, so that nothing typed is lost.
     const structure = JSON.stringify([desc.panel.title, desc.panel.fields.map((f) =>
       [f.name, f.kind, f.size, f.tunable, f.stateIndex, f.min, f.max, f.label, f.unit, f.choices])]);
+    this.setCommands(desc);
     if (key === this.key) return;
     this.key = key;
     if (structure === this.structure) {
@@ -113,6 +123,19 @@ export class ControlPanel {
     // each value's tooltip names its joint (the URDF's names, or joint1, joint2, ...).
     const names = jointLabels(desc);
     const perJoint = (f) => names && f.kind === 'vector' && f.size === names.length;
+    // Joint values are shown as an operator reads them: revolute joints in degrees, prismatic
+    // ones in millimetres (the program's values are in rad and m).
+    const prismatic = desc.prismatic || [];
+    const display = (f, i) => {
+      if (!perJoint(f) || (f.unit !== 'rad' && f.unit !== 'rad/s')) return { scale: 1, unit: f.unit };
+      const p = prismatic[i];
+      return { scale: p ? 1000 : 180 / Math.PI, unit: (p ? 'mm' : 'deg') + (f.unit === 'rad/s' ? '/s' : '') };
+    };
+    const unitOf = (f) => {
+      if (!perJoint(f)) return f.unit;
+      const units = [...new Set(names.map((_, i) => display(f, i).unit))];
+      return units.join(' or ');
+    };
     if (names && desc.panel.fields.some(perJoint)) {
       rows.push(el('div', { class: 'row joint-names' }, el('label', {}, 'joint'),
         el('div', { class: 'values' }, ...names.map((name) => el('span', { class: 'joint-name', title: name }, name)))));
@@ -170,14 +193,53 @@ export class ControlPanel {
             span.dataset.joint = names[i];
           }
           cell.append(span);
-          this.cells.push({ span, index: f.stateIndex + i, field: f });
+          this.cells.push({ span, index: f.stateIndex + i, field: f, scale: display(f, i).scale });
         }
       }
-      const row = el('div', { class: 'row' }, el('label', {}, `${f.label}${f.unit ? ` [${f.unit}]` : ''}${f.tunable ? ' (tunable)' : ''}`), cell);
+      const unit = f.tunable ? f.unit : unitOf(f);
+      const row = el('div', { class: 'row' }, el('label', {}, `${f.label}${unit ? ` [${unit}]` : ''}${f.tunable ? ' (tunable)' : ''}`), cell);
       if (error) row.append(error);
       rows.push(row);
     }
+    if (desc.kind === 'manipulator') {
+      // The end-effector's pose in the world (setEndEffector(), from the 3D view's frames).
+      this.endEffector = el('div', { class: 'values', 'data-field': 'endEffector' }, '-');
+      rows.push(el('div', { class: 'row' }, el('label', {}, 'End-effector [mm, deg]'), this.endEffector));
+    } else {
+      this.endEffector = null;
+    }
     this.body.replaceChildren(...rows);
+  }
+  // The command buttons, rebuilt when the object's commands change.
+  setCommands(desc) {
+    const key = JSON.stringify(desc.commands || []);
+    if (key === this.commandKey) return;
+    this.commandKey = key;
+    const buttons = (desc.commands || []).map((c) => el('button', { 'data-command': c.name, title: c.description || c.name,
+      onclick: () => this.run(c.name) }, c.name));
+    this.commands.replaceChildren(...buttons);
+    this.commands.classList.toggle('hidden', buttons.length === 0);
+  }
+  // Runs command `name`; shows what it did, or why it was refused.
+  run(name) {
+    return this.conn.command(this.name, name).then((r) => {
+      this.showResult(`${name}: ${(r && r.reply) || 'done'}`, false);
+    }, (e) => {
+      this.showResult(`${name}: ${e.message}`, true);
+      this.notify(`${this.name}: ${name}: ${e.message}`);
+    });
+  }
+  showResult(text, refused) {
+    this.result.textContent = text;
+    this.result.className = `panel-result ${refused ? 'error' : ''}`;
+  }
+  // The end-effector pose: position [mm], roll, pitch, yaw [deg] (a manipulator's panel).
+  setEndEffector(pose) {
+    if (!this.endEffector || !pose) return;
+    const f = (x) => x.toFixed(1);
+    const text = `x ${f(pose.position[0])}  y ${f(pose.position[1])}  z ${f(pose.position[2])}  ` +
+      `roll ${f(pose.rpy[0])}  pitch ${f(pose.rpy[1])}  yaw ${f(pose.rpy[2])}`;
+    if (this.endEffector.textContent !== text) this.endEffector.textContent = text;
   }
   // The object's error status, or the system shutdown once the program reported one.
   showStatus() {
@@ -202,7 +264,7 @@ export class ControlPanel {
     for (const c of this.cells) {
       const v = values[c.index];
       if (v === undefined) continue;
-      let text = fmt(v);
+      let text = fmt(v * (c.scale || 1));
       if (c.field.kind === 'boolean') text = v ? 'on' : 'off';
       else if (c.field.kind === 'choice') text = c.field.choices[v] ?? String(v);
       c.span.textContent = text;

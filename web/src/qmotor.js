@@ -1,5 +1,8 @@
 // QMotor window: live plots (uPlot) of an object's state values and its tunable parameters.
-// The values come with the state frames (60 Hz); the last 10 s are shown.
+// The values come with the state frames (60 Hz); the last 10 s are shown. Pause freezes the plot
+// (samples keep coming); a drag zooms in on a time span and the wheel pans it, both freezing the
+// plot so that the next frame does not undo them; Live follows again; the values under the cursor
+// are read out; Export PNG saves the plot.
 import 'uplot/dist/uPlot.min.css';
 import uPlot from 'uplot';
 import './style.css';
@@ -21,6 +24,23 @@ let series = []; // [{label, index}]
 let data = [[]];
 let samples = 0;
 let dirty = false;
+let frozen = false; // paused, zoomed or panned: the plot shows what it showed
+const modeEl = document.getElementById('plot-mode');
+const cursorEl = document.getElementById('plot-cursor');
+let cursor = null; // { t, values: { label: value } } under the mouse
+
+function freeze(why) {
+  // The plot keeps a copy of the samples it shows: new ones go on arriving in `data`.
+  if (!frozen && plot) plot.setData(data.map((a) => a.slice()), false);
+  frozen = true;
+  modeEl.textContent = why;
+}
+function live() {
+  frozen = false;
+  modeEl.textContent = 'live';
+  if (plot) plot.setData(data); // the latest samples, scales fitted to them again
+  dirty = false;
+}
 
 function makePlot() {
   if (plot) plot.destroy();
@@ -32,8 +52,50 @@ function makePlot() {
     scales: { x: { time: false } },
     axes: [{ label: 'time [s]' }, {}],
     series: [{ label: 't' }, ...series.map((s, i) => ({ label: s.label, stroke: colors[i % colors.length], width: 1.5 }))],
+    cursor: { drag: { x: true, y: false } },
+    hooks: {
+      // A drag zooms in: keep it (the next frame would reset the scales).
+      setSelect: [(u) => {
+        if (u.select.width > 2) freeze('zoomed');
+      }],
+      setCursor: [(u) => {
+        const i = u.cursor.idx;
+        if (i == null || !u.data[0].length) {
+          cursor = null;
+          cursorEl.textContent = '';
+          return;
+        }
+        cursor = { t: u.data[0][i], values: {} };
+        series.forEach((s, k) => (cursor.values[s.label] = u.data[k + 1][i]));
+        cursorEl.textContent = `t ${cursor.t.toFixed(3)} s: ` +
+          series.map((s) => `${s.label} ${Number(cursor.values[s.label]).toPrecision(5)}`).join(', ');
+      }],
+    },
   }, data, plotEl);
+  // The wheel pans the shown time span (and freezes the plot there).
+  plot.over.addEventListener('wheel', (ev) => {
+    ev.preventDefault();
+    const { min, max } = plot.scales.x;
+    if (min == null || max == null) return;
+    const shift = (max - min) * 0.1 * Math.sign(ev.deltaY || ev.deltaX);
+    freeze('panned');
+    plot.setScale('x', { min: min + shift, max: max + shift });
+  }, { passive: false });
+  if (frozen) {
+    frozen = false; // a new plot (other fields): frozen again with its own copy
+    freeze(modeEl.textContent);
+  }
 }
+
+document.getElementById('plot-pause').addEventListener('click', () => freeze('paused'));
+document.getElementById('plot-live').addEventListener('click', live);
+document.getElementById('plot-png').addEventListener('click', () => {
+  if (!plot) return;
+  const a = document.createElement('a');
+  a.download = `qmotor-${objectName || 'plot'}-${new Date().toISOString().replace(/[:.]/g, '-')}.png`;
+  a.href = plot.ctx.canvas.toDataURL('image/png');
+  a.click();
+});
 
 function buildFields(desc) {
   const fields = desc.panel.fields.filter((f) => f.stateIndex >= 0 && (f.kind === 'vector' || f.kind === 'number'));
@@ -116,7 +178,7 @@ const conn = new Connection({
 
 const redraw = () => {
   requestAnimationFrame(redraw);
-  if (dirty && plot) {
+  if (dirty && plot && !frozen) {
     plot.setData(data);
     dirty = false;
   }
@@ -131,6 +193,9 @@ window.rp = {
   get samples() { return samples; },
   get series() { return series.map((s) => s.label); },
   get data() { return data; },
+  get plot() { return plot; },
+  get frozen() { return frozen; },
+  get cursor() { return cursor; },
 };
 
 // ---- Log variables: plots of any column of the program's log file, and start/stop logging ----

@@ -1,12 +1,18 @@
 // Small page helpers shared by the viewer and the utility pages.
 
-// Shows `text` in the #messages bar for five seconds.
+// Shows `text` (an error, a refusal) in the #messages bar for five seconds.
 export function notify(text) {
   const messages = document.getElementById('messages');
   messages.textContent = text;
-  messages.classList.remove('hidden');
+  messages.classList.remove('hidden', 'info');
   clearTimeout(notify.timer);
   notify.timer = setTimeout(() => messages.classList.add('hidden'), 5000);
+}
+
+// Shows `text` (what a command did) in the #messages bar for five seconds, as information.
+export function inform(text) {
+  notify(text);
+  document.getElementById('messages').classList.add('info');
 }
 
 // Shows the connection state in #status.

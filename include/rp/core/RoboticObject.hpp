@@ -165,13 +165,24 @@ class RoboticObject {
   /// @throws std::invalid_argument if a command of that name exists
   /// Real-time safe: no.
   void addCommand(const std::string& name, std::function<void()> action, const std::string& description = "");
+  /// Registers a command whose action says what it did, e.g. "arm power on" (the GUI shows it); a
+  /// command that cannot be carried out throws, and the GUI shows why.
+  /// @param[in] name         command name
+  /// @param[in] action       what it does (runs in the caller's thread); returns the result text
+  /// @param[in] description  one line for the GUI
+  /// @throws std::invalid_argument if a command of that name exists
+  /// Real-time safe: no.
+  void addCommandWithResult(const std::string& name, std::function<std::string()> action,
+                            const std::string& description = "");
   /// The registered commands in registration order. Real-time safe: no.
   std::vector<CommandInfo> getCommands() const;
   /// Runs the command `name`.
   /// @param[in] name  command name
-  /// @throws std::invalid_argument if there is no such command (the message lists the known ones)
+  /// @return what the command did (its action's text; "done" for a command added with addCommand())
+  /// @throws std::invalid_argument if there is no such command (the message lists the known ones);
+  ///         whatever the action throws when it cannot be carried out
   /// Real-time safe: no.
-  void executeCommand(const std::string& name);
+  std::string executeCommand(const std::string& name);
   /// @}
 
   /// @name Shutdown
@@ -293,6 +304,13 @@ class RoboticObject {
  protected:
   /// Marks the shutdown complete (for classes overriding startShutdown()). Real-time safe: yes.
   void setShutdownComplete() noexcept;
+  /// For the actions of a device's commands (addCommandWithResult()): returns `done` when the
+  /// device carried the command out (`ok`), else throws std::runtime_error with the object's error
+  /// status (what its driver said), so the GUI shows why the command failed.
+  /// @param[in] ok    whether the device carried the command out
+  /// @param[in] done  the result text
+  /// Real-time safe: no.
+  std::string commandResult(bool ok, const std::string& done) const;
 
  private:
   friend class ObjectManager;

@@ -205,6 +205,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void install(Setup& setup) noexcept;     // swaps the setup's parts with the manipulator's
   void applySetup(Setup& setup) noexcept;  // in the servo thread between cycles: install and carry the state over
   void applyWrenches(int n);               // the last external wrenches to the simulation
+  void addOperatorCommands();              // Power On/Off, Gravity Compensation, Zero Gravity, Hold Here
 
   bool inServoThread() const;
   void waitUntilNotExecuting(const void* object) const;
