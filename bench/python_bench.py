@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Python benchmark of the roboticplatform module (issue 16): single-call and batched forward
-kinematics, Jacobian and inverse dynamics (RNEA) of the Puma 560 from Python, next to PyKDL in
-the same run; the batched call per row next to the C++ loop (model_bench's *_rp figures, run
-here); and a batched call in two Python threads next to two in sequence (the GIL released).
+kinematics, Jacobian and inverse dynamics (RNEA) of the Puma 560 and the WAM 7 from Python, next
+to PyKDL in the same run; the batched call per row next to the C++ loop (model_bench's *_rp/6 and
+*_rp/7 figures, run here); and a batched call in two Python threads next to two in sequence (the
+GIL released), for each arm.
 
 Run: PYTHONPATH=build/python python3 bench/python_bench.py [--model-bench build/bin/model_bench]
 Figures, not assertions: see docs/python.md.
@@ -45,49 +46,45 @@ def best_of(f, runs=5):
 
 
 def cpp_figures(model_bench):
-    """ns per call of the C++ loops (6-joint Puma) from model_bench."""
+    """ns per call of the C++ loops from model_bench: {(name, joints): ns}, 6 the Puma, 7 the WAM."""
     if not model_bench or not Path(model_bench).exists():
         return {}
-    out = subprocess.run([model_bench, "--benchmark_filter=(ForwardKinematics|Jacobian|InverseDynamics)_rp/6",
+    out = subprocess.run([model_bench, "--benchmark_filter=(ForwardKinematics|Jacobian|InverseDynamics)_rp/(6|7)$",
                           "--benchmark_format=json", "--benchmark_min_time=0.2"], capture_output=True, text=True,
                          check=True)
-    return {b["name"].split("_rp")[0]: b["real_time"] for b in json.loads(out.stdout)["benchmarks"]}
+    figures = {}
+    for b in json.loads(out.stdout)["benchmarks"]:
+        name, joints = b["name"].split("_rp/")
+        figures[(name, int(joints))] = b["real_time"]
+    return figures
 
 
-def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--model-bench", default=str(Path(__file__).resolve().parents[1] / "build" / "bin" / "model_bench"))
-    parser.add_argument("--rows", type=int, default=100000)
-    args = parser.parse_args()
-
-    model = rp.Puma560Model()
+def bench_arm(title, model, rows, cpp):
+    n = model.dof
     chain = kdl_reference.chain(model)
     rng = np.random.default_rng(0)
-    q = rng.uniform(-1, 1, 6)
-    Q = rng.uniform(-1, 1, (args.rows, 6))
-    jq = K.JntArray(6)
-    for i in range(6):
+    q = rng.uniform(-1, 1, n)
+    Q = rng.uniform(-1, 1, (rows, n))
+    jq = K.JntArray(n)
+    for i in range(n):
         jq[i] = q[i]
     fk_solver, jac_solver = K.ChainFkSolverPos_recursive(chain), K.ChainJntToJacSolver(chain)
     id_solver = K.ChainIdSolver_RNE(chain, K.Vector(*model.gravity))
-    frame, jac, tau = K.Frame(), K.Jacobian(6), K.JntArray(6)
+    frame, jac, tau = K.Frame(), K.Jacobian(n), K.JntArray(n)
     wrenches = [K.Wrench() for _ in range(chain.getNrOfSegments())]
-    zero = K.JntArray(6)
-    cpp = cpp_figures(args.model_bench)
 
-    rows = [
+    table = [
         ("ForwardKinematics", lambda: model.fk(q), lambda: fk_solver.JntToCart(jq, frame), lambda: model.fk_batch(Q)),
         ("Jacobian", lambda: model.jacobian(q), lambda: jac_solver.JntToJac(jq, jac), lambda: model.jacobian_batch(Q)),
         ("InverseDynamics", lambda: model.rnea(q, q, q), lambda: id_solver.CartToJnt(jq, jq, jq, wrenches, tau),
          lambda: model.rnea_batch(Q, Q, Q)),
     ]
-    print(f"{'Puma 560':<18} {'rp single':>10} {'PyKDL':>10} {'rp batched':>11} {'C++ loop':>9}   (us per call / row)")
-    for name, single, kdl, batched in rows:
+    print(f"{title:<18} {'rp single':>10} {'PyKDL':>10} {'rp batched':>11} {'C++ loop':>9}   (us per call / row)")
+    for name, single, kdl, batched in table:
         t_single, t_kdl = per_call(single, 20000), per_call(kdl, 20000)
-        t_batch = best_of(batched) / args.rows * 1e6
-        t_cpp = cpp.get(name, float("nan")) / 1000
+        t_batch = best_of(batched) / rows * 1e6
+        t_cpp = cpp.get((name, n), float("nan")) / 1000
         print(f"{name:<18} {t_single:>10.3f} {t_kdl:>10.3f} {t_batch:>11.3f} {t_cpp:>9.3f}")
-    del zero
 
     # Two threads, each a batched RNEA over all rows, against the two in sequence.
     sequential = best_of(lambda: (model.rnea_batch(Q, Q, Q), model.rnea_batch(Q, Q, Q)), 3)
@@ -100,8 +97,19 @@ def main():
             t.join()
 
     parallel = best_of(two_threads, 3)
-    print(f"rnea_batch x2: sequential {sequential * 1e3:.1f} ms, two Python threads {parallel * 1e3:.1f} ms "
+    print(f"{title}: rnea_batch x2: sequential {sequential * 1e3:.1f} ms, two Python threads {parallel * 1e3:.1f} ms "
           f"(ratio {parallel / sequential:.2f})")
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--model-bench", default=str(Path(__file__).resolve().parents[1] / "build" / "bin" / "model_bench"))
+    parser.add_argument("--rows", type=int, default=100000)
+    args = parser.parse_args()
+    cpp = cpp_figures(args.model_bench)
+    bench_arm("Puma 560", rp.Puma560Model(), args.rows, cpp)
+    print()
+    bench_arm("WAM 7", rp.WAMModel(7), args.rows, cpp)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 // Loading manipulator models from URDF (rp/model/UrdfModel.hpp).
 #include "rp/model/UrdfModel.hpp"
 
+#include <console_bridge/console.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <tinyxml.h>
@@ -17,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <mutex>
 #include <numbers>
 #include <unordered_map>
 #include <unordered_set>
@@ -520,6 +522,57 @@ void checkMimics(const urdf::ModelInterface& robot, const std::string& fileName)
   }
 }
 
+// urdfdom's parser, with the errors it reports (through console_bridge, on stderr by default)
+// collected for the UrdfError instead: they name the joint or link it refused. Its warnings still
+// go where console_bridge's handler sent them. The handler is global: one parse at a time, and the
+// collector is never destroyed (console_bridge keeps a pointer to it as its "previous" handler).
+urdf::ModelInterfaceSharedPtr parseCollectingErrors(const std::string& text, std::vector<std::string>& errors) {
+  struct Collector : console_bridge::OutputHandler {
+    console_bridge::OutputHandler* previous = nullptr;
+    std::vector<std::string>* errors = nullptr;  // null: forward everything
+    void log(const std::string& message, console_bridge::LogLevel level, const char* file, int line) override {
+      if (errors && level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) errors->push_back(message);
+      else if (previous) previous->log(message, level, file, line);
+    }
+  };
+  static std::mutex parsing;
+  static Collector* const collector = new Collector;
+  const std::lock_guard<std::mutex> lock(parsing);
+  if (console_bridge::OutputHandler* current = console_bridge::getOutputHandler(); current != collector)
+    collector->previous = current;
+  collector->errors = &errors;
+  console_bridge::useOutputHandler(collector);
+  struct Restore {
+    ~Restore() {
+      collector->errors = nullptr;
+      console_bridge::useOutputHandler(collector->previous);
+    }
+  } restore;
+  return urdf::parseURDF(text);
+}
+
+// Why urdfdom refused the document: where the XML is malformed, "LINE:COLUMN: ... malformed XML
+// (what)"; otherwise the errors urdfdom reported (naming the joint or link).
+std::string invalidDocument(const std::string& text, const std::string& fileName, const std::vector<std::string>& errors) {
+  constexpr const char* kInvalid = "not a valid URDF document";
+  TiXmlDocument doc;
+  doc.Parse(text.c_str());
+  if (doc.Error()) {
+    std::string what = doc.ErrorDesc();
+    while (!what.empty() && (what.back() == '.' || std::isspace(static_cast<unsigned char>(what.back())))) what.pop_back();
+    return fileName + ":" + std::to_string(doc.ErrorRow()) + ":" + std::to_string(doc.ErrorCol()) + ": " + kInvalid +
+           ": malformed XML (" + what + ")";
+  }
+  std::string reasons;
+  for (const std::string& e : errors) {
+    if (e == "joint xml is not initialized correctly" || e == "link xml is not initialized correctly")
+      continue;  // urdfdom's follow-up to the error before it
+    reasons += reasons.empty() ? "" : "; ";
+    reasons += e;
+  }
+  return fileName + ": " + kInvalid + (reasons.empty() ? std::string(" (malformed XML or URDF structure)") : ": " + reasons);
+}
+
 // urdfdom links children with shared pointers: a long chain would be freed by one recursive
 // destructor call per link (a stack overflow for 100,000 links) and a loop would never be freed.
 // Dropping those pointers first leaves each link to be freed alone by the model's own maps.
@@ -537,8 +590,9 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
   const std::string text = readUrdfFile(fileName);
   checkNesting(text, fileName);
   checkDocument(text, fileName);
-  const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text);
-  if (!robot) throw UrdfError(fileName + ": not a valid URDF document (malformed XML or URDF structure)");
+  std::vector<std::string> urdfdomErrors;
+  const urdf::ModelInterfaceSharedPtr robot = parseCollectingErrors(text, urdfdomErrors);
+  if (!robot) throw UrdfError(invalidDocument(text, fileName, urdfdomErrors));
   const UnlinkOnExit unlink{*robot};
   const urdf::LinkConstSharedPtr root = robot->getRoot();
   if (!root) throw UrdfError(fileName + ": the robot has no root link");

@@ -279,7 +279,9 @@ TEST(UrdfModel, BadFilesGiveClearErrors) {
     return "no error";
   };
   EXPECT_EQ(message(kData + "/missing.urdf"), kData + "/missing.urdf: cannot read the file");
-  EXPECT_NE(message(kData + "/bad_xml.urdf").find("not a valid URDF document"), std::string::npos);
+  // Malformed XML: where TinyXML found it (the document ends inside <robot>, line 3 column 1).
+  EXPECT_EQ(message(kData + "/bad_xml.urdf"),
+            kData + "/bad_xml.urdf:3:1: not a valid URDF document: malformed XML (Error reading end tag)");
   EXPECT_NE(message(kData + "/floating.urdf").find("joint 'free' is floating or planar"), std::string::npos);
   UrdfOptions unknownTip;
   unknownTip.tip = "gripper";
@@ -532,6 +534,25 @@ TEST_F(UrdfInputTest, JointsMustNameDefinedLinksAndOneRoot) {
   EXPECT_EQ(message(f), f + ": joint 'j' has no parent link");
   f = write("j.urdf", base + "<link name=\"c\"/>" + joint("j", "revolute", "a", "b") + "</robot>");
   EXPECT_EQ(message(f), f + ": links 'a' and 'c' both have no parent joint; a robot has one root link");
+}
+
+// What urdfdom itself refuses, it names (through console_bridge): the UrdfError carries its
+// errors (without its follow-up "joint xml is not initialized correctly"), and where the XML is
+// malformed the line and column.
+TEST_F(UrdfInputTest, UrdfdomsOwnErrorsAndTheLineOfMalformedXmlAreInTheMessage) {
+  const std::string base = "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/>";
+  std::string f = write("u.urdf", base + "<joint name=\"ball\" type=\"spherical\"><parent link=\"a\"/>"
+                                           "<child link=\"b\"/></joint></robot>");
+  EXPECT_EQ(message(f), f + ": not a valid URDF document: Joint [ball] has no known type [spherical]");
+  f = write("u.urdf", base + "<joint name=\"elbow\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
+                             "</joint></robot>");
+  EXPECT_EQ(message(f), f + ": not a valid URDF document: Joint [elbow] is of type REVOLUTE but it does not specify limits");
+  f = write("u.urdf", "<notrobot/>");
+  EXPECT_EQ(message(f), f + ": not a valid URDF document: Could not find the 'robot' element in the xml file");
+  f = write("u.urdf", "<robot name=\"r\">\n  <link name=\"a\">\n  <link name=\"b\"/>\n</robot>\n");
+  EXPECT_EQ(message(f), f + ":4:1: not a valid URDF document: malformed XML (Error reading end tag)");
+  // Loading again works: the collector of urdfdom's errors was taken off again.
+  EXPECT_EQ(message(kData + "/test_arm.urdf"), "no error");
 }
 
 // Found by rp_urdf_fuzzer: limits the model refuses were thrown as a bare std::invalid_argument

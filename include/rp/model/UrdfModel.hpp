@@ -64,7 +64,9 @@ struct UrdfOptions {
 /// @param[in] fileName  path of the URDF file
 /// @param[in] options   tip link and whether dynamics are required
 /// @return the model, named after the robot
-/// @throws UrdfError naming the file for: a missing or unreadable file, malformed XML or URDF, a
+/// @throws UrdfError naming the file for: a missing or unreadable file, malformed XML (with the
+///         line and column: `FILE:LINE:COLUMN: ...`) or URDF (with urdfdom's own errors, which
+///         name the joint or link; they no longer go to stderr), a
 ///         floating or planar joint in the chain, an unknown tip, a branching robot
 ///         without a tip, no movable joint, a number that is not finite (naming the joint or
 ///         link), a mimic joint naming a missing joint (or mimics in a circle), a mimic joint on
