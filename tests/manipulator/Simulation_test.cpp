@@ -563,6 +563,46 @@ TEST_F(SimulationPlantArm, DefaultManipulatorTakesItsPlantFromRpCfg) {
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(std::round(later(i) * 1000), later(i) * 1000, 1e-6) << "joint " << i + 1;
 }
 
+// Through the WAM object (servo loop, limit checks, damped hold), not the bare plant: its light
+// wrist joint 7 driven at 0.8 rad/s into its upper stop. The position limit is a fault; the hold
+// stops the joint at the stop without bouncing back (before the stops were dissipative, 2 of 8
+// runs published joint 7 at -80.7 rad/s here), then the power goes off.
+TEST_F(SimulationPlantArm, TheWamsWristRunsIntoItsStopAndComesToRest) {
+  for (SimulationIntegrator integrator : {SimulationIntegrator::RK4, SimulationIntegrator::Euler}) {
+    ObjectManager::resetShutdown();
+    RoboticPlatform::setConfiguration(Configuration::parse(
+        std::string("[wam]\nclass WAM\nintegrator ") + (integrator == SimulationIntegrator::RK4 ? "rk4" : "euler") + "\n",
+        "rp.cfg"));
+    WAM wam("wam", 7);
+    const double limit = wam.getModel().getPositionMax()(6);
+    test::JointRamp ramp(6, 0.8);
+    test::simClock().pause();
+    wam.setTrajectoryGenerator(ramp);
+    double fastest = 0, deepest = -1;
+    bool finite = true;
+    int cycles = 0;
+    for (; cycles < 20000 && !wam.isShutdownComplete(); ++cycles) {
+      ASSERT_TRUE(wam.runCycles(1, 10));
+      const JointVector q = wam.getJointPosition(), qd = wam.getJointVelocity();
+      finite = finite && q.allFinite() && qd.allFinite();
+      fastest = std::max(fastest, qd.cwiseAbs().maxCoeff());
+      deepest = std::max(deepest, q(6) - limit);
+    }
+    test::simClock().resume();
+    std::printf("  WAM 7 (%s) joint 7 into its stop: %d cycles, fastest joint %.3f rad/s, %.4f rad beyond the limit\n",
+                integrator == SimulationIntegrator::RK4 ? "rk4" : "euler", cycles, fastest, deepest);
+    EXPECT_TRUE(finite);
+    EXPECT_TRUE(wam.isShutdownComplete()) << "the position limit did not stop the system";
+    EXPECT_NE(ObjectManager::getShutdownReason().find("joint 7"), std::string::npos) << ObjectManager::getShutdownReason();
+    EXPECT_GT(deepest, 0.0) << "joint 7 never reached its limit";
+    EXPECT_LT(deepest, 0.05) << "joint 7 went far into its stop";
+    EXPECT_LT(fastest, 1.6) << "a joint was flung (twice the driven speed)";
+    EXPECT_LT(wam.getJointVelocity().cwiseAbs().maxCoeff(), 1e-2) << "not at rest when the power went off";
+    EXPECT_FALSE(wam.isArmPowerOn());
+    wam.clearTrajectoryGenerator();
+  }
+}
+
 // ---- Real time ---------------------------------------------------------------------------------
 
 TEST(SimulationRealTime, SteppingDoesNotAllocate) {
