@@ -1,5 +1,5 @@
 // Loading arms from URDF: forward kinematics against a direct walk of the URDF (urdfdom),
-// dynamics against Orocos KDL built from the same URDF with KDL's own API, a round trip through
+// dynamics against Orocos KDL built from the same URDF by kdl_parser, a round trip through
 // the exporter, and clear errors for bad files.
 #include <gtest/gtest.h>
 
@@ -17,10 +17,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <numbers>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 #include "KdlChain.hpp"
+#include "KdlFromUrdf.hpp"
 #include "ModifiedDh.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
@@ -46,43 +50,6 @@ std::vector<urdf::JointConstSharedPtr> chainTo(const urdf::ModelInterfaceSharedP
   return chain;
 }
 
-using test::kdlFrame;
-
-KDL::RigidBodyInertia kdlInertia(const urdf::Inertial& i) {
-  const Transform T = pose(i.origin);
-  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
-  Eigen::Matrix3d I;
-  I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
-  const Eigen::Matrix3d Il = R * I * R.transpose();
-  return KDL::RigidBodyInertia(i.mass, KDL::Vector(T(0, 3), T(1, 3), T(2, 3)),
-                               KDL::RotationalInertia(Il(0, 0), Il(1, 1), Il(2, 2), Il(0, 1), Il(0, 2), Il(1, 2)));
-}
-
-// The KDL chain of the URDF, the way kdl_parser builds it (revolute joints about, prismatic joints
-// along their axis); the camera (fixed to l3, off the chain)
-// is added to l3's inertia.
-KDL::Chain kdlFromUrdf(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip) {
-  KDL::Chain chain;
-  for (const urdf::JointConstSharedPtr& j : chainTo(robot, tip)) {
-    const KDL::Frame origin = kdlFrame(pose(j->parent_to_joint_origin_transform));
-    const urdf::LinkConstSharedPtr child = robot->getLink(j->child_link_name);
-    KDL::RigidBodyInertia inertia = child->inertial ? kdlInertia(*child->inertial) : KDL::RigidBodyInertia::Zero();
-    for (const urdf::JointSharedPtr& c : child->child_joints) {
-      if (c->child_link_name == "camera") {
-        inertia = inertia + kdlFrame(pose(c->parent_to_joint_origin_transform)) * kdlInertia(*robot->getLink("camera")->inertial);
-      }
-    }
-    if (j->type == urdf::Joint::FIXED) {
-      chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, KDL::Joint::Fixed), origin, inertia));
-    } else {
-      const KDL::Vector axis = origin.M * KDL::Vector(j->axis.x, j->axis.y, j->axis.z);
-      const KDL::Joint::JointType type = j->type == urdf::Joint::PRISMATIC ? KDL::Joint::TransAxis : KDL::Joint::RotAxis;
-      chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, origin.p, axis, type), origin, inertia));
-    }
-  }
-  return chain;
-}
-
 TEST(UrdfModel, ForwardKinematicsAndDynamicsMatchUrdfdomAndKdl) {
   UrdfOptions options;
   options.tip = "tool";
@@ -93,7 +60,7 @@ TEST(UrdfModel, ForwardKinematicsAndDynamicsMatchUrdfdomAndKdl) {
   EXPECT_DOUBLE_EQ(model->getTorqueLimit()(0), 80);
   EXPECT_DOUBLE_EQ(model->getPositionMax()(1), 2.0);
   const urdf::ModelInterfaceSharedPtr robot = parse(kData + "/test_arm.urdf");
-  const KDL::Chain chain = kdlFromUrdf(robot, "tool");
+  const KDL::Chain chain = test::kdlArm(kData + "/test_arm.urdf", robot, "tool").chain;  // the camera lumped into l3
   KDL::ChainIdSolver_RNE id(chain, KDL::Vector(0, 0, -9.81));
   KDL::ChainJntToJacSolver jac(chain);
   KDL::ChainDynParam dyn(chain, KDL::Vector(0, 0, -9.81));
@@ -161,7 +128,7 @@ TEST(UrdfModel, PrismaticJointsMatchUrdfWalkAndKdl) {
   EXPECT_DOUBLE_EQ(model->getPositionMax()(3), 0.35);
   EXPECT_DOUBLE_EQ(model->getTorqueLimit()(1), 300);
   const urdf::ModelInterfaceSharedPtr robot = parse(kData + "/prismatic_arm.urdf");
-  const KDL::Chain chain = kdlFromUrdf(robot, "tool");
+  const KDL::Chain chain = test::kdlArm(kData + "/prismatic_arm.urdf", robot, "tool").chain;
   KDL::ChainFkSolverPos_recursive fk(chain);
   KDL::ChainIdSolver_RNE id(chain, KDL::Vector(0, 0, -9.81));
   KDL::ChainJntToJacSolver jac(chain);
