@@ -283,14 +283,15 @@ TEST(UrdfModel, DefaultTipIgnoresBranchesOfFixedFramesAndStopsBeforeGrippers) {
   EXPECT_EQ(model->getLinkName(5), "link06");
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_EQ(notes[0], kData + "/jaw_arm.urdf: links 'gripperMover' move off the chain: their mass is lumped into 'link06' "
-                              "at jointGripper = 0 (UrdfOptions::offChainPositions sets other values)");
+                              "at jointGripper = 0 rad (other values: UrdfOptions::offChainPositions, rp.cfg "
+                              "offChainPositions, rp-model --offchain)");
   notes.clear();
   model = loadUrdf(kData + "/panda_like.urdf", options);
   ASSERT_EQ(model->getNumberOfJoints(), 7);
   EXPECT_EQ(model->getLinkName(6), "link7");
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("links 'leftfinger', 'rightfinger' move off the chain: their mass is lumped into 'link7' at "
-                          "finger_joint1 = 0, finger_joint2 = 0"),
+                          "finger_joint1 = 0 m, finger_joint2 = 0 m"),
             std::string::npos)
       << notes[0];
 }
@@ -357,7 +358,7 @@ TEST(UrdfModel, MovingLinksOffTheChainAreLumpedAtTheStatedConfiguration) {
   open.notes = &notes;
   const std::unique_ptr<ManipulatorModel> a = loadUrdf(f, open);
   ASSERT_EQ(notes.size(), 1u);
-  EXPECT_NE(notes[0].find("finger_joint1 = 0.015, finger_joint2 = 0.04"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("finger_joint1 = 0.015 m, finger_joint2 = 0.04 m"), std::string::npos) << notes[0];
   const std::unique_ptr<ManipulatorModel> closed = loadUrdf(kData + "/panda_like.urdf");
   // Finger masses 0.015 each, hand rotated -45 deg about z in link7: the fingers open along the
   // hand's y axis by 0.015 (left, +y) and 0.04 (right, -y).
@@ -373,6 +374,55 @@ TEST(UrdfModel, MovingLinksOffTheChainAreLumpedAtTheStatedConfiguration) {
   EXPECT_EQ(error(kData + "/panda_like.urdf", "rightfinger"),
             kData + "/panda_like.urdf: joint 'finger_joint2' mimics joint 'finger_joint1', which is not a joint of the "
                     "chain; a mimic joint on the chain follows a joint of the chain");
+}
+
+// UrdfOptions::offChainPositions: each entry must name a moving joint off the chain that moves a
+// lumped link, with a finite value within its limits; else UrdfOptionError names the file, the
+// option and the joint (and lists the moving joints off the chain). In rp.cfg's units (degrees
+// and millimetres) the same positions lump the same masses.
+TEST(UrdfModel, OffChainPositionsAreCheckedAndNamed) {
+  const std::string jaw = kData + "/jaw_arm.urdf", panda = kData + "/panda_like.urdf";
+  auto error = [](const std::string& file, const std::map<std::string, double>& positions, bool degrees = false) {
+    UrdfOptions o;
+    o.offChainPositions = positions;
+    o.offChainInDegreesAndMillimetres = degrees;
+    try {
+      loadUrdf(file, o);
+    } catch (const UrdfOptionError& e) {
+      EXPECT_EQ(e.option(), "offChainPositions");
+      EXPECT_EQ(std::string(e.what()), file + ": UrdfOptions::offChainPositions: " + e.problem());
+      return e.problem();
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error(jaw, {{"jointGripper", -1.2}}), "no error");
+  EXPECT_EQ(error(jaw, {{"nosuch", 0}}), "there is no joint 'nosuch' (moving joints off the chain: jointGripper)");
+  EXPECT_EQ(error(jaw, {{"jointGripper", std::nan("")}}), "joint 'jointGripper': the value is not finite");
+  EXPECT_EQ(error(jaw, {{"joint3", 0.1}}), "joint 'joint3' is a joint of the arm, not off the chain (moving joints off "
+                                           "the chain: jointGripper)");
+  EXPECT_EQ(error(jaw, {{"jointGripper", 0.5}}), "joint 'jointGripper': 0.5 rad is outside its limits -1.57 .. 0 rad");
+  EXPECT_EQ(error(jaw, {{"jointGripper", -100}}, true), "joint 'jointGripper': -100 deg is outside its limits -89.9544 .. 0 deg");
+  EXPECT_EQ(error(panda, {{"finger_joint1", 50}}, true), "joint 'finger_joint1': 50 mm is outside its limits 0 .. 40 mm");
+  EXPECT_EQ(error(panda, {{"joint8", 0}}), "joint 'joint8' is fixed, floating or planar: it has no position (moving "
+                                           "joints off the chain: finger_joint1, finger_joint2)");
+  // Degrees and millimetres: the same lumped masses as radians and metres.
+  for (const auto& [file, joint, si, cfg] : {std::tuple{jaw, "jointGripper", -1.2, -1.2 * 180 / std::numbers::pi},
+                                             std::tuple{panda, "finger_joint1", 0.03, 30.0}}) {
+    UrdfOptions a, b;
+    a.offChainPositions[joint] = si;
+    b.offChainPositions[joint] = cfg;
+    b.offChainInDegreesAndMillimetres = true;
+    const std::unique_ptr<ManipulatorModel> ma = loadUrdf(file, a), mb = loadUrdf(file, b), closed = loadUrdf(file);
+    const int last = ma->getNumberOfJoints() - 1;
+    // The lumped link's mass distribution: its first moment and inertia (the Panda's fingers open
+    // symmetrically, which keeps the centre of mass and changes the inertia).
+    auto differ = [&](const ManipulatorModel& x, const ManipulatorModel& y) {
+      const LinkParameters &l = x.getLink(last), &r = y.getLink(last);
+      return (Eigen::Vector3d(l.com) - Eigen::Vector3d(r.com)).norm() + (Eigen::Matrix3d(l.inertia) - Eigen::Matrix3d(r.inertia)).norm();
+    };
+    EXPECT_LT(differ(*ma, *mb), 1e-15) << file;
+    EXPECT_GT(differ(*ma, *closed), 1e-6) << file << ": the position changes the lumped link";
+  }
 }
 
 // A mimic joint on the chain that names a missing joint is refused, naming the file and both
