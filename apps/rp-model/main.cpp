@@ -1,12 +1,14 @@
 // rp-model: kinematics and dynamics of a built-in robot from the command line, as JSON.
 //
-//   rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] COMMAND --q v1,v2,... [options]
+//   rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] [--offchain name=value,...] COMMAND --q v1,v2,... [options]
 //
 // COMMAND: fk | jacobian | gravity | rnea --qd .. --qdd .. | inertia | fd --qd .. --tau .. |
 //          ik --pose p1,...,p16 [--seed ..] | urdf | mjcf
 // Options: --motor-inertia and --friction add those effects to inertia, rnea and fd.
 // Joint values (--q, --qd, --qdd, --tau, --seed): "v1,v2,..." in joint order, or "name=value,..."
 // naming every joint once. Every result also lists the model's "joints" and "links" by name.
+// --offchain (URDF robots): where moving joints off the chain (fingers, a jaw) stand when their
+// links are lumped into the arm, "name=value,..." (UrdfOptions::offChainPositions; default zero).
 // Units: SI and radians. Matrices are JSON arrays of rows. Bad input: one line on stderr, exit 2
 // (values that are not finite numbers, a --pose that is not a rigid transform).
 #include <nlohmann/json.hpp>
@@ -51,6 +53,23 @@ std::vector<double> numbers(const std::string& option, const std::string& text) 
 }
 
 // One value per joint: "v1,v2,..." in joint order, or "name=value,..." naming every joint once.
+// --offchain "name=value,...": positions of moving joints off the chain [rad or m], each joint once.
+std::map<std::string, double> offChainOf(const std::string& text) {
+  std::map<std::string, double> positions;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0) throw UsageError("--offchain: '" + item + "' is not a name=value pair");
+    const std::string joint = item.substr(0, eq);
+    const std::vector<double> v = numbers("--offchain", item.substr(eq + 1));
+    if (v.size() != 1) throw UsageError("--offchain: '" + item + "' is not a name=value pair");
+    if (!positions.emplace(joint, v[0]).second) throw UsageError("--offchain: joint '" + joint + "' is given twice");
+  }
+  if (positions.empty()) throw UsageError("--offchain: no name=value pair");
+  return positions;
+}
+
 JointVector jointsOf(const ManipulatorModel& model, const std::map<std::string, std::string>& opts,
                      const std::string& name, bool required) {
   const int n = model.getNumberOfJoints();
@@ -125,7 +144,8 @@ int run(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
-      std::cout << "usage: rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] COMMAND --q v1,v2,...|name=value,... [--qd ..] [--qdd ..] [--tau ..]\n"
+      std::cout << "usage: rp-model --robot puma560|wam4|wam7|PATH.urdf [--tip LINK] [--offchain name=value,...] COMMAND\n"
+                   "                --q v1,v2,...|name=value,... [--qd ..] [--qdd ..] [--tau ..]\n"
                    "                [--pose p1,...,p16] [--seed ..] [--motor-inertia] [--friction]\n"
                    "COMMAND: fk jacobian gravity rnea inertia fd ik urdf mjcf\n";
       return 0;
@@ -153,17 +173,24 @@ int run(int argc, char** argv) {
     if (opts.count("--tip")) urdf.tip = opts.at("--tip");
     urdf.requireDynamics =
         command == "gravity" || command == "rnea" || command == "inertia" || command == "fd" || command == "mjcf";
+    if (opts.count("--offchain")) urdf.offChainPositions = offChainOf(opts.at("--offchain"));
     std::vector<std::string> notes;
     urdf.notes = &notes;
-    model = loadUrdf(robot, urdf);
+    try {
+      model = loadUrdf(robot, urdf);
+    } catch (const UrdfOptionError& e) {
+      throw UsageError("--offchain: " + e.problem() + " in " + robot);
+    }
     for (const std::string& note : notes) std::cerr << "rp-model: note: " << note << std::endl;
   } else {
     throw UsageError("unknown robot '" + robot + "' (known: puma560, wam4, wam7, or a .urdf file)");
   }
   if (opts.count("--tip") && robot.find(".urdf") == std::string::npos) throw UsageError("--tip applies to URDF robots only");
+  if (opts.count("--offchain") && robot.find(".urdf") == std::string::npos)
+    throw UsageError("--offchain applies to URDF robots only");
   for (const auto& [key, value] : opts) {
-    static const std::vector<std::string> known = {"--robot", "--tip", "--q", "--qd", "--qdd", "--tau", "--pose", "--seed",
-                                                   "--motor-inertia", "--friction"};
+    static const std::vector<std::string> known = {"--robot", "--tip", "--offchain", "--q", "--qd", "--qdd", "--tau", "--pose",
+                                                   "--seed", "--motor-inertia", "--friction"};
     if (std::find(known.begin(), known.end(), key) == known.end()) throw UsageError("unknown option " + key);
     (void)value;
   }

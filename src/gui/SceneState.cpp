@@ -99,6 +99,8 @@ void SceneState::loadVisuals(Entry& e) {
     UrdfVisualOptions options;
     options.tip = arm->getTip();
     options.packagePath = arm->getPackagePath();
+    options.offChainPositions = arm->getOffChainPositions();
+    options.offChainInDegreesAndMillimetres = true;
     e.urdfVisuals = readUrdfVisuals(arm->getUrdfFile(), options);
   } catch (const std::exception& ex) {
     e.urdfError = ex.what();

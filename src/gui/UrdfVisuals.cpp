@@ -11,6 +11,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <functional>
+#include <numbers>
 #include <sstream>
 
 #include "rp/model/Kinematics.hpp"
@@ -168,6 +169,8 @@ std::vector<UrdfVisual> readUrdfVisuals(const std::string& urdfFile, const UrdfV
   // The model (and the checks) of loadUrdf(): the link frames the shapes are attached to.
   UrdfOptions options;
   options.tip = tip;
+  options.offChainPositions = visualOptions.offChainPositions;
+  options.offChainInDegreesAndMillimetres = visualOptions.offChainInDegreesAndMillimetres;
   const std::unique_ptr<ManipulatorModel> model = loadUrdf(urdfFile, options);
   std::ifstream in(urdfFile);
   if (!in) throw UrdfError(urdfFile + ": cannot read the file");
@@ -195,12 +198,22 @@ std::vector<UrdfVisual> readUrdfVisuals(const std::string& urdfFile, const UrdfV
   };
 
   // Where a moving joint off the chain (a finger, a jaw) stands: where loadUrdf() lumps its links
-  // by default (a mimic joint at its master's value times the multiplier plus the offset; zero
-  // within the limits otherwise).
+  // (the position given, which loadUrdf() has checked; a mimic joint at its master's value times
+  // the multiplier plus the offset; zero within the limits otherwise).
+  auto given = [&](const urdf::Joint& j, double& v) {
+    const auto it = visualOptions.offChainPositions.find(j.name);
+    if (it == visualOptions.offChainPositions.end()) return false;
+    const double scale = !visualOptions.offChainInDegreesAndMillimetres ? 1.0
+                         : j.type == urdf::Joint::PRISMATIC             ? 1e-3
+                                                                        : std::numbers::pi / 180;
+    v = it->second * scale;
+    return true;
+  };
   auto offChainMotion = [&](const urdf::Joint& joint) {
     const urdf::Joint* j = &joint;
     double multiplier = 1, offset = 0, v = 0;
     for (std::size_t depth = 0; depth <= robot->joints_.size() && j; ++depth) {
+      if (given(*j, v)) break;
       if (!j->mimic) {
         if (j->limits && j->type != urdf::Joint::CONTINUOUS) v = std::clamp(0.0, j->limits->lower, j->limits->upper);
         break;

@@ -1,8 +1,11 @@
 // A manipulator described by a URDF file (rp/manipulator/UrdfManipulator.hpp).
 #include "rp/manipulator/UrdfManipulator.hpp"
 
+#include <charconv>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <stdexcept>
 #include <tuple>
 #include <utility>
@@ -27,6 +30,34 @@ std::pair<std::string, std::string> resolve(const ConfigSection* section, std::s
   return {file, tip};
 }
 
+// rp.cfg's `offChainPositions joint=value ...` [deg or mm] (empty without the setting); a word that
+// is no joint=value pair with a finite number, or a joint given twice, is refused at its line.
+std::map<std::string, double> offChainSetting(const ConfigSection* section) {
+  std::map<std::string, double> positions;
+  if (section == nullptr) return positions;
+  const ConfigSetting* setting = section->find("offChainPositions");
+  if (setting == nullptr) return positions;
+  for (const std::string& word : setting->values) {
+    std::string quoted(1, '\'');  // piece by piece: GCC 12 warns (-Wrestrict) about "'" + s
+    quoted += ConfigError::excerpt(word);
+    quoted += '\'';
+    const std::size_t eq = word.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == word.size())
+      throw section->errorAt(*setting, "offChainPositions: " + quoted +
+                                           " is not a joint=value pair (value in deg, or mm for a prismatic joint)");
+    const std::string joint = word.substr(0, eq), text = word.substr(eq + 1);
+    const char* begin = text.data() + (text[0] == '+' ? 1 : 0);
+    double value = 0;
+    const auto [end, ec] = std::from_chars(begin, text.data() + text.size(), value);
+    if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
+      throw section->errorAt(*setting, "offChainPositions: joint '" + ConfigError::excerpt(joint) + "': '" +
+                                           ConfigError::excerpt(text) + "' is not a finite number");
+    if (!positions.emplace(joint, value).second)
+      throw section->errorAt(*setting, "offChainPositions: joint '" + ConfigError::excerpt(joint) + "' is given twice");
+  }
+  return positions;
+}
+
 std::unique_ptr<ManipulatorModel> loadFor(const ConfigSection* section, const std::string& name,
                                           const std::string& urdfFile, const std::string& tipLink,
                                           const Transform& base) {
@@ -35,9 +66,18 @@ std::unique_ptr<ManipulatorModel> loadFor(const ConfigSection* section, const st
   UrdfOptions options;
   options.tip = tip;
   options.requireDynamics = true;
+  options.offChainPositions = offChainSetting(section);
+  options.offChainInDegreesAndMillimetres = true;
   std::vector<std::string> notes;
   options.notes = &notes;
-  std::unique_ptr<ManipulatorModel> m = loadUrdf(file, options);
+  std::unique_ptr<ManipulatorModel> m;
+  try {
+    m = loadUrdf(file, options);
+  } catch (const UrdfOptionError& e) {  // a joint of rp.cfg's offChainPositions: refused at its line
+    const ConfigSetting* setting = section != nullptr ? section->find("offChainPositions") : nullptr;
+    if (setting == nullptr) throw;
+    throw section->errorAt(*setting, "offChainPositions: " + e.problem() + " in " + file);
+  }
   for (const std::string& note : notes) std::cerr << "rp: UrdfManipulator '" << name << "': " << note << std::endl;
   // Place the arm where the object stands: the object's pose times the URDF's own base frame.
   const ManipulatorModel& chain = m->getChain();  // with mimic joints: the whole chain, coupled again below
@@ -60,6 +100,8 @@ UrdfManipulator::UrdfManipulator(const std::string& name, const std::string& urd
 
 UrdfManipulator::~UrdfManipulator() { stopControlLoop(); }
 
+std::map<std::string, double> UrdfManipulator::getOffChainPositions() const { return offChainSetting(configSection()); }
+
 std::vector<std::string> UrdfManipulator::getPackagePath() const {
   if (const ConfigSection* section = configSection())
     if (section->has("packagePath"))
@@ -73,6 +115,17 @@ void UrdfManipulator::declareSettings(SettingSchema& schema) {
   schema.addWord("urdf", "URDF file of the arm");
   schema.addWord("tip", "last link of the chain");
   schema.addWord("packagePath", "folders holding the packages of package:// mesh files, separated by ':'");
+  SettingSpec offChain;
+  offChain.name = "offChainPositions";
+  offChain.kind = SettingKind::Word;
+  offChain.minValues = 1;
+  offChain.maxValues = 64;
+  offChain.unit = "deg or mm";
+  offChain.description =
+      "joint=value pairs: where moving joints off the chain (fingers, a jaw) stand when their links are lumped into "
+      "the arm (revolute in deg, prismatic in mm)";
+  offChain.defaultValue = "(zero within each joint's limits; a mimic joint follows its master)";
+  schema.add(offChain);
   schema.setDefault("urdf", "the constructor's argument");
   schema.setDefault("tip", "the constructor's argument");
   schema.setDefault("packagePath", "(none: ROS_PACKAGE_PATH, then the folders above the URDF file)");

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "ExportFrames.hpp"
+#include "ExportNames.hpp"
 #include "rp/model/PhysicalModel.hpp"
 
 namespace rp {
@@ -13,6 +14,7 @@ namespace rp {
 namespace {
 
 using internal::exact;
+using internal::xmlEscape;
 
 std::string quaternion(const Eigen::Matrix3d& R) {
   const Eigen::Quaterniond q(R);
@@ -71,16 +73,17 @@ std::string exportMjcf(const ManipulatorModel& model, const MjcfOptions& options
     << "\" gravity=\"" << exact(g(0)) << " " << exact(g(1)) << " " << exact(g(2)) << "\"/>\n";
   x << "  <worldbody>\n";
   std::string indent = "    ";
-  x << indent << "<body name=\"base_link\" " << placement(model.getBaseTransform()) << ">\n";
+  const internal::ExportNames names = internal::exportNames(model);
+  x << indent << "<body name=\"" << xmlEscape(names.base) << "\" " << placement(model.getBaseTransform()) << ">\n";
   Transform previous = Transform::unit();  // post_{k-1}
   for (int k = 0; k < n; ++k) {
     indent += "  ";
     const LinkParameters& l = m.getLink(k);
     const internal::JointFrames frames = internal::jointFrames(m, k);
     const internal::JointFriction friction = internal::jointFriction(l);
-    const std::string number = std::to_string(k + 1);
-    x << indent << "<body name=\"link" << number << "\" " << placement(Transform(previous * frames.pre)) << ">\n";
-    x << indent << "  <joint name=\"joint" << number << "\" type=\""
+    x << indent << "<body name=\"" << xmlEscape(names.links[static_cast<std::size_t>(k)]) << "\" "
+      << placement(Transform(previous * frames.pre)) << ">\n";
+    x << indent << "  <joint name=\"" << xmlEscape(names.joints[static_cast<std::size_t>(k)]) << "\" type=\""
       << (l.type == JointType::Prismatic ? "slide" : "hinge") << "\" axis=\"0 0 1\" limited=\"true\" range=\""
       << exact(l.positionMin) << " " << exact(l.positionMax) << "\" armature=\"" << exact(m.getArmatureInertia()(k))
       << "\" damping=\"" << exact(l.viscousFriction * l.gearRatio * l.gearRatio) << "\" frictionloss=\""
@@ -92,7 +95,7 @@ std::string exportMjcf(const ManipulatorModel& model, const MjcfOptions& options
     x << indent << "  " << inertial(l, frames.post) << "\n";
     previous = frames.post;
   }
-  x << indent << "  <site name=\"tool\" " << placement(Transform(previous * model.getToolTransform())) << "/>\n";
+  x << indent << "  <site name=\"" << xmlEscape(names.tool) << "\" " << placement(Transform(previous * model.getToolTransform())) << "/>\n";
   for (int k = n; k >= 0; --k) {
     x << indent << "</body>\n";
     indent.resize(indent.size() - 2);
@@ -100,8 +103,8 @@ std::string exportMjcf(const ManipulatorModel& model, const MjcfOptions& options
   x << "  </worldbody>\n  <actuator>\n";
   for (int k = 0; k < n; ++k) {
     const double limit = m.getTorqueLimit()(k);
-    x << "    <motor name=\"motor" << k + 1 << "\" joint=\"joint" << k + 1 << "\" ctrllimited=\"true\" ctrlrange=\""
-      << exact(-limit) << " " << exact(limit) << "\"/>\n";
+    x << "    <motor name=\"motor" << k + 1 << "\" joint=\"" << xmlEscape(names.joints[static_cast<std::size_t>(k)])
+      << "\" ctrllimited=\"true\" ctrlrange=\"" << exact(-limit) << " " << exact(limit) << "\"/>\n";
   }
   x << "  </actuator>\n  <keyframe>\n    <key name=\"home\" qpos=\"";
   for (int k = 0; k < n; ++k) x << (k ? " " : "") << exact(model.getHomePosition()(k));

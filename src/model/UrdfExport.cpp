@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "ExportFrames.hpp"
+#include "ExportNames.hpp"
 #include "rp/model/PhysicalModel.hpp"
 
 namespace rp {
@@ -13,6 +14,7 @@ namespace rp {
 namespace {
 
 using internal::exact;
+using internal::xmlEscape;
 
 std::string origin(const Transform& t) {
   const Vector<3> rpy = transformToRPY(t);
@@ -40,16 +42,18 @@ std::string toUrdf(const ManipulatorModel& model) {
       << internal::correctionLines(physical, "       ");
   }
   x << "  -->\n";
-  x << "  <link name=\"world\"/>\n  <link name=\"base_link\"/>\n";
-  x << "  <joint name=\"base\" type=\"fixed\">\n    <parent link=\"world\"/>\n    <child link=\"base_link\"/>\n    "
-    << origin(model.getBaseTransform()) << "\n  </joint>\n";
+  const internal::ExportNames names = internal::exportNames(model);
+  x << "  <link name=\"" << xmlEscape(names.world) << "\"/>\n  <link name=\"" << xmlEscape(names.base) << "\"/>\n";
+  x << "  <joint name=\"" << xmlEscape(names.baseJoint) << "\" type=\"fixed\">\n    <parent link=\"" << xmlEscape(names.world)
+    << "\"/>\n    <child link=\"" << xmlEscape(names.base) << "\"/>\n    " << origin(model.getBaseTransform())
+    << "\n  </joint>\n";
   Transform previous = Transform::unit();  // post_{k-1}
   for (int k = 0; k < n; ++k) {
     const LinkParameters& l = m.getLink(k);
     const internal::JointFrames frames = internal::jointFrames(m, k);
     const internal::JointFriction friction = internal::jointFriction(l);
-    const std::string link = "link" + std::to_string(k + 1);
-    const std::string joint = "joint" + std::to_string(k + 1);
+    const std::string link = xmlEscape(names.links[static_cast<std::size_t>(k)]);
+    const std::string joint = xmlEscape(names.joints[static_cast<std::size_t>(k)]);
     const internal::PrincipalInertia principal = internal::principalInertia(l.inertia);
     Transform axes = Transform::unit();
     axes.topLeftCorner<3, 3>() = principal.axes;
@@ -59,7 +63,7 @@ std::string toUrdf(const ManipulatorModel& model) {
       << exact(principal.moments(1)) << "\" iyz=\"0\" izz=\"" << exact(principal.moments(2))
       << "\"/>\n    </inertial>\n  </link>\n";
     x << "  <joint name=\"" << joint << "\" type=\"" << (l.type == JointType::Prismatic ? "prismatic" : "revolute")
-      << "\">\n    <parent link=\"" << (k == 0 ? std::string("base_link") : "link" + std::to_string(k))
+      << "\">\n    <parent link=\"" << xmlEscape(k == 0 ? names.base : names.links[static_cast<std::size_t>(k - 1)])
       << "\"/>\n    <child link=\"" << link << "\"/>\n    " << origin(Transform(previous * frames.pre))
       << "\n    <axis xyz=\"0 0 1\"/>\n    <limit lower=\"" << exact(l.positionMin) << "\" upper=\""
       << exact(l.positionMax) << "\" effort=\"" << exact(l.torqueLimit) << "\" velocity=\"" << exact(l.velocityLimit)
@@ -84,8 +88,10 @@ std::string toUrdf(const ManipulatorModel& model) {
     }
     previous = frames.post;
   }
-  x << "  <link name=\"tool\"/>\n  <joint name=\"tool\" type=\"fixed\">\n    <parent link=\"link" << n
-    << "\"/>\n    <child link=\"tool\"/>\n    " << origin(Transform(previous * model.getToolTransform()))
+  const std::string tool = xmlEscape(names.tool);
+  x << "  <link name=\"" << tool << "\"/>\n  <joint name=\"" << tool << "\" type=\"fixed\">\n    <parent link=\""
+    << xmlEscape(names.links[static_cast<std::size_t>(n - 1)]) << "\"/>\n    <child link=\"" << tool << "\"/>\n    "
+    << origin(Transform(previous * model.getToolTransform()))
     << "\n  </joint>\n</robot>\n";
   return x.str();
 }

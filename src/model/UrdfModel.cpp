@@ -19,6 +19,7 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <set>
 #include <numbers>
 #include <unordered_map>
 #include <unordered_set>
@@ -441,6 +442,46 @@ bool looksLikeGripper(std::string name) {
 
 bool isGripperJoint(const urdf::Joint& j) { return looksLikeGripper(j.name) || looksLikeGripper(j.child_link_name); }
 
+// "%g" of a number.
+std::string shortNumber(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+// UrdfOptions::offChainPositions checked against the description and in radians and metres: each
+// name a revolute, continuous or prismatic joint off the chain (`chainLinks`: the child links of
+// the chain's joints), each value finite and within the joint's limits. Whether a joint moves a
+// link that is lumped into the arm is checked after the walk (loadUrdf()).
+std::map<std::string, double> offChainPositions(const urdf::ModelInterface& robot, const UrdfOptions& options,
+                                                const std::unordered_set<std::string>& chainLinks,
+                                                const std::string& fileName) {
+  std::string movingOff;  // the moving joints off the chain, for messages
+  for (const auto& [name, joint] : robot.joints_)
+    if (joint && isMovable(*joint) && !chainLinks.count(joint->child_link_name))
+      movingOff += (movingOff.empty() ? "" : ", ") + excerpt(name);
+  const std::string candidates = " (moving joints off the chain: " + (movingOff.empty() ? std::string("none") : movingOff) + ")";
+  auto fail = [&](const std::string& problem) { return UrdfOptionError(fileName, "offChainPositions", problem); };
+  std::map<std::string, double> si;
+  for (const auto& [name, given] : options.offChainPositions) {
+    const std::string joint = "joint '" + excerpt(name) + "'";
+    const urdf::JointConstSharedPtr j = robot.getJoint(name);
+    if (!j) throw fail("there is no " + joint + candidates);
+    if (!std::isfinite(given)) throw fail(joint + ": the value is not finite");
+    if (!isMovable(*j)) throw fail(joint + " is fixed, floating or planar: it has no position" + candidates);
+    if (chainLinks.count(j->child_link_name)) throw fail(joint + " is a joint of the arm, not off the chain" + candidates);
+    const bool prismatic = j->type == urdf::Joint::PRISMATIC;
+    const char* unit = options.offChainInDegreesAndMillimetres ? (prismatic ? " mm" : " deg") : (prismatic ? " m" : " rad");
+    const double scale = !options.offChainInDegreesAndMillimetres ? 1.0 : prismatic ? 1e-3 : std::numbers::pi / 180;
+    const double value = given * scale;
+    if (j->limits && j->type != urdf::Joint::CONTINUOUS && (value < j->limits->lower || value > j->limits->upper))
+      throw fail(joint + ": " + shortNumber(given) + unit + " is outside its limits " + shortNumber(j->limits->lower / scale) +
+                 " .. " + shortNumber(j->limits->upper / scale) + unit);
+    si[name] = value;
+  }
+  return si;
+}
+
 // The default tip: from the root, follow the one child joint whose subtree moves (a branch that
 // carries only fixed frames, such as tool0 or a camera, is no branch) to the last moving link.
 // Where everything that moves further on is a gripper (joints or links named grip..., finger,
@@ -623,12 +664,16 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
   for (const urdf::JointConstSharedPtr& j : chain) chainLinks.insert(j->child_link_name);
   // The value at which a moving joint off the chain is lumped: the user's, its master's for a
   // mimic joint (multiplier and offset), or zero within its limits.
+  const std::map<std::string, double> given = offChainPositions(*robot, options, chainLinks, fileName);
+  std::set<std::string> used;  // the joints of `given` a lumped link's position was taken from
   auto offChainValue = [&](const urdf::Joint& joint) {
     const urdf::Joint* j = &joint;
     double multiplier = 1, offset = 0;
     for (std::size_t depth = 0; depth <= robot->joints_.size(); ++depth) {
-      if (const auto it = options.offChainPositions.find(j->name); it != options.offChainPositions.end())
+      if (const auto it = given.find(j->name); it != given.end()) {
+        used.insert(j->name);
         return multiplier * it->second + offset;
+      }
       if (!j->mimic) break;
       offset += multiplier * j->mimic->offset;
       multiplier *= j->mimic->multiplier;
@@ -638,11 +683,6 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     if (j->limits && j->type != urdf::Joint::CONTINUOUS) v = std::clamp(0.0, j->limits->lower, j->limits->upper);
     return multiplier * v + offset;
   };
-  for (const auto& [name, value] : options.offChainPositions) {
-    if (!robot->getJoint(name)) throw UrdfError(fileName + ": UrdfOptions::offChainPositions: there is no joint '" + excerpt(name) + "'");
-    if (!std::isfinite(value))
-      throw UrdfError(fileName + ": UrdfOptions::offChainPositions: joint '" + excerpt(name) + "': the value is not finite");
-  }
   // A link's inertia and that of everything hanging on it off the chain: fixed (a camera) or
   // moving (fingers, a jaw: at offChainValue(), reported in a note), walked with an explicit
   // stack: a chain of many fixed links must not recurse once per link.
@@ -684,7 +724,7 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
           else motion.topLeftCorner<3, 3>() = Eigen::AngleAxisd(v, axis.normalized()).toRotationMatrix();
           child = Transform(child * motion);
           char value[64];
-          std::snprintf(value, sizeof value, " = %g", v);
+          std::snprintf(value, sizeof value, " = %g %s", v, c->type == urdf::Joint::PRISMATIC ? "m" : "rad");
           if (!movingJoints.empty()) movingJoints += ", ";
           movingJoints += excerpt(c->name);
           movingJoints += value;
@@ -702,7 +742,7 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     if (!movedLinks.empty() && options.notes) {
       options.notes->push_back(fileName + ": links " + movedLinks + " move off the chain: their mass is lumped into '" +
                                excerpt(links.back().joint->child_link_name) + "' at " + movingJoints +
-                               " (UrdfOptions::offChainPositions sets other values)");
+                               " (other values: UrdfOptions::offChainPositions, rp.cfg offChainPositions, rp-model --offchain)");
     }
   };
   for (const urdf::JointConstSharedPtr& j : chain) {
@@ -734,6 +774,11 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
     }
     addInertial(robot->getLink(j->child_link_name), C);
   }
+  for (const auto& entry : given)
+    if (!used.count(entry.first))
+      throw UrdfOptionError(fileName, "offChainPositions",
+                            "joint '" + excerpt(entry.first) +
+                                "' moves no link that is lumped into the arm (it hangs on the base, or below a floating or planar joint)");
   const int n = static_cast<int>(links.size());
   if (n == 0) throw UrdfError(fileName + ": no revolute, continuous or prismatic joint between the root and '" + tip->name + "'");
   if (n > kMaxJoints) throw UrdfError(fileName + ": " + std::to_string(n) + " joints; at most " + std::to_string(kMaxJoints));

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <string>
 #include <unistd.h>
@@ -186,7 +187,8 @@ TEST(UrdfVisuals, LinksOfMimicJointsMoveWithTheirMaster) {
 // Issue 20: links moved by joints off the chain (two fingers, the second a mimic) are drawn, on
 // the chain link they hang on, where loadUrdf() lumps them (and says so in a note): at the
 // fingers' lower limit 0.01 m (zero is outside it), the mimic finger at -0.5 * master + 0.05
-// along its own axis. They used to be left out.
+// along its own axis, or where UrdfVisualOptions::offChainPositions puts them. They used to be
+// left out.
 TEST(UrdfVisuals, MovingLinksOffTheChainAreDrawnWhereTheyAreLumped) {
   const std::string file = (std::filesystem::temp_directory_path() / "rp_urdf_visuals_fingers.urdf").string();
   const std::string box = "<visual><geometry><box size=\"0.02 0.02 0.06\"/></geometry></visual>";
@@ -212,11 +214,22 @@ TEST(UrdfVisuals, MovingLinksOffTheChainAreDrawnWhereTheyAreLumped) {
   EXPECT_NE(notes[0].find("links 'left_finger', 'right_finger' move off the chain: their mass is lumped into 'upper'"),
             std::string::npos) << notes[0];  // ... and the loader says so
   const rp::Transform hand = rp::Transform(rp::translation(0.3, 0, 0) * rotY(1.5707963267948966));
-  {
-    const double left = 0.01;
-    const auto visuals = rp::readUrdfVisuals(file, rp::UrdfVisualOptions());
+  // By default; where UrdfVisualOptions::offChainPositions puts the master (in m, or in mm as
+  // rp.cfg gives it); the mimic finger named itself.
+  struct Case {
+    std::map<std::string, double> positions;
+    bool millimetres;
+    double left, right;
+  };
+  for (const Case& c : {Case{{}, false, 0.01, -0.5 * 0.01 + 0.05}, Case{{{"finger_left", 0.03}}, false, 0.03, -0.5 * 0.03 + 0.05},
+                        Case{{{"finger_left", 25}}, true, 0.025, -0.5 * 0.025 + 0.05},
+                        Case{{{"finger_right", 0.02}}, false, 0.01, 0.02}}) {
+    rp::UrdfVisualOptions options;
+    options.offChainPositions = c.positions;
+    options.offChainInDegreesAndMillimetres = c.millimetres;
+    const auto visuals = rp::readUrdfVisuals(file, options);
     ASSERT_EQ(visuals.size(), 3u);
-    const double right = -0.5 * left + 0.05;
+    const double left = c.left, right = c.right;
     const rp::Transform expected[3] = {hand, rp::Transform(hand * rp::translation(0, left, 0.05)),
                                        rp::Transform(hand * rp::translation(0, -right, 0.05))};
     for (std::size_t i = 0; i < 3; ++i) {
@@ -265,7 +278,7 @@ std::string meshOf(const std::vector<rp::UrdfVisual>& visuals, const std::string
 
 TEST(UrdfVisuals, PackageMeshesFoundInTheFoldersAboveTheDescription) {
   TempDir temp;
-  const auto visuals = rp::readUrdfVisuals(kMeshArm, {"hand_link", {}});
+  const auto visuals = rp::readUrdfVisuals(kMeshArm, {"hand_link", {}, {}, false});
   ASSERT_EQ(visuals.size(), 7u);
   const auto meshes = std::filesystem::absolute(kPackages + "/rp_mesh_arm/meshes").lexically_normal();
   EXPECT_EQ(meshOf(visuals, "upper_link"), (meshes / "upper_arm.dae").string());
@@ -291,32 +304,32 @@ TEST(UrdfVisuals, MovedDescriptionFindsItsPackagesThroughThePackagePath) {
   const auto moved = temp.path() / "mesh_arm.urdf";
   std::filesystem::copy_file(kMeshArm, moved);
   // Nothing above the moved file holds the package: not found, and the error says where it looked.
-  auto lost = rp::readUrdfVisuals(moved.string(), {"hand_link", {}});
+  auto lost = rp::readUrdfVisuals(moved.string(), {"hand_link", {}, {}, false});
   ASSERT_EQ(lost.size(), 7u);
   EXPECT_EQ(lost[1].shape.meshFile, "");
   EXPECT_NE(lost[1].meshError.find("no such file"), std::string::npos) << lost[1].meshError;
   EXPECT_NE(lost[1].meshError.find((temp.path() / "rp_mesh_arm/meshes/upper_arm.dae").string()), std::string::npos)
       << lost[1].meshError;
   // The package path (as rp.cfg's packagePath gives it) finds them; a folder without the package is passed over.
-  const auto found = rp::readUrdfVisuals(moved.string(), {"hand_link", {"/nonexistent", kPackages}});
+  const auto found = rp::readUrdfVisuals(moved.string(), {"hand_link", {"/nonexistent", kPackages}, {}, false});
   EXPECT_EQ(found[1].meshError, "");
   EXPECT_EQ(found[1].shape.meshFile,
             std::filesystem::absolute(kPackages + "/rp_mesh_arm/meshes/upper_arm.dae").lexically_normal().string());
   // So does ROS_PACKAGE_PATH.
   ::setenv("ROS_PACKAGE_PATH", ("/nonexistent:" + kPackages).c_str(), 1);
-  EXPECT_EQ(rp::readUrdfVisuals(moved.string(), {"hand_link", {}})[1].shape.meshFile, found[1].shape.meshFile);
+  EXPECT_EQ(rp::readUrdfVisuals(moved.string(), {"hand_link", {}, {}, false})[1].shape.meshFile, found[1].shape.meshFile);
   // The package path comes before ROS_PACKAGE_PATH, each in its order: a second copy of the
   // package's base.obj in the temporary folder wins when it is listed first.
   std::filesystem::create_directories(temp.path() / "pkgs/rp_mesh_arm/meshes");
   std::ofstream(temp.path() / "pkgs/rp_mesh_arm/meshes/base.obj") << "v 0 0 0\n";
-  const auto mine = rp::readUrdfVisuals(moved.string(), {"hand_link", {(temp.path() / "pkgs").string()}});
+  const auto mine = rp::readUrdfVisuals(moved.string(), {"hand_link", {(temp.path() / "pkgs").string()}, {}, false});
   EXPECT_EQ(mine[0].shape.meshFile, (temp.path() / "pkgs/rp_mesh_arm/meshes/base.obj").string());
   EXPECT_EQ(mine[1].shape.meshFile, found[1].shape.meshFile);  // not in pkgs: from ROS_PACKAGE_PATH
 }
 
 TEST(UrdfVisuals, MeshesThatCannotBeDrawnSayWhyAndBringTheCollisionGeometry) {
   TempDir temp;
-  const auto visuals = rp::readUrdfVisuals(kMeshArm, {"hand_link", {}});
+  const auto visuals = rp::readUrdfVisuals(kMeshArm, {"hand_link", {}, {}, false});
   const rp::UrdfVisual& sensor = visuals[5];
   EXPECT_EQ(sensor.link, "sensor_link");
   EXPECT_EQ(sensor.shape.meshFile, "");
@@ -343,7 +356,7 @@ TEST(UrdfVisuals, MeshesThatCannotBeDrawnSayWhyAndBringTheCollisionGeometry) {
   const std::string base = "package://rp_mesh_arm/meshes/base.obj";
   text.replace(text.find(base), base.size(), "part.ply");
   std::ofstream(temp.path() / "arm.urdf", std::ios::trunc) << text;
-  const auto ply = rp::readUrdfVisuals((temp.path() / "arm.urdf").string(), {"hand_link", {kPackages}});
+  const auto ply = rp::readUrdfVisuals((temp.path() / "arm.urdf").string(), {"hand_link", {kPackages}, {}, false});
   EXPECT_EQ(ply[0].shape.meshFile, "");
   EXPECT_NE(ply[0].meshError.find("format not drawn"), std::string::npos) << ply[0].meshError;
 }

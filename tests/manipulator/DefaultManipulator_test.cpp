@@ -14,6 +14,8 @@
 #include <numbers>
 #include <random>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "AllocationCounter.hpp"
 #include "SimulatedArmTest.hpp"
@@ -544,6 +546,42 @@ TEST_F(ManipulatorTest, AnyArmFromAUrdfFileIsSimulatedAndHeld) {
   om.deleteObject(arm);
   RoboticPlatform::setConfiguration(Configuration::parse("[arm]\nclass UrdfManipulator\nurdf nosuchfile.urdf\n", "rp.cfg"));
   EXPECT_THROW(om.createDerivedObject<Manipulator>("arm"), UrdfError);
+}
+
+// Issue 20: rp.cfg's offChainPositions puts the jaw where it is lumped into the arm (deg, as
+// simInitialPosition): the same link 6 as loadUrdf() with the jaw at -pi/4 rad. A word that is no
+// joint=value pair, a joint the file has no moving joint off the chain of, a value outside the
+// joint's limits or a joint given twice is a ConfigError at the setting's line naming the joint.
+TEST_F(ManipulatorTest, UrdfArmLumpsLinksOffTheChainWhereRpCfgSays) {
+  const std::string head = "[arm]\nclass UrdfManipulator\nurdf " RP_TEST_MODEL_DATA "/jaw_arm.urdf\noffChainPositions ";
+  RoboticPlatform::setConfiguration(Configuration::parse(head + "jointGripper=-45\n", "rp.cfg"));
+  ObjectManager om;
+  Manipulator* arm = om.createDerivedObject<Manipulator>("arm");
+  UrdfOptions options;
+  options.offChainPositions["jointGripper"] = -std::numbers::pi / 4;
+  const std::unique_ptr<ManipulatorModel> expected = loadUrdf(RP_TEST_MODEL_DATA "/jaw_arm.urdf", options);
+  const std::unique_ptr<ManipulatorModel> closed = loadUrdf(RP_TEST_MODEL_DATA "/jaw_arm.urdf");
+  ASSERT_EQ(arm->getNumberOfJoints(), 6);
+  const LinkParameters &got = arm->getModel().getLink(5), &want = expected->getLink(5);
+  EXPECT_LT((Eigen::Vector3d(got.com) - Eigen::Vector3d(want.com)).norm(), 1e-15);
+  EXPECT_LT((Eigen::Matrix3d(got.inertia) - Eigen::Matrix3d(want.inertia)).norm(), 1e-15);
+  EXPECT_GT((Eigen::Vector3d(got.com) - Eigen::Vector3d(closed->getLink(5).com)).norm(), 1e-3) << "the jaw moved";
+  om.deleteObject(arm);
+  for (const auto& [value, message] : std::vector<std::pair<std::string, std::string>>{
+           {"nosuch=0", "offChainPositions: there is no joint 'nosuch' (moving joints off the chain: jointGripper) in "},
+           {"jointGripper=open", "offChainPositions: joint 'jointGripper': 'open' is not a finite number"},
+           {"jointGripper", "offChainPositions: 'jointGripper' is not a joint=value pair"},
+           {"jointGripper=10", "offChainPositions: joint 'jointGripper': 10 deg is outside its limits -89.9544 .. 0 deg in "},
+           {"joint3=5", "offChainPositions: joint 'joint3' is a joint of the arm, not off the chain"},
+           {"jointGripper=-10 jointGripper=-20", "offChainPositions: joint 'jointGripper' is given twice"}}) {
+    RoboticPlatform::setConfiguration(Configuration::parse(head + value + "\n", "rp.cfg"));
+    try {
+      om.createDerivedObject<Manipulator>("arm");
+      ADD_FAILURE() << value << " was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("rp.cfg:4: " + message, 0), 0u) << value << ": " << e.what();
+    }
+  }
 }
 
 // Counts the allocations the servo thread makes between two consecutive calculate() calls: the

@@ -32,9 +32,26 @@ set(cases
   # Issue 20: joint values by name: an unknown name, a joint left out, names mixed with positions.
   "--robot ${DATA}/ur_like.urdf fk --q nosuch_joint=0"
   "--robot puma560 fk --q joint1=0,joint2=0"
-  "--robot puma560 fk --q joint1=0,0,0,0,0,0")
+  "--robot puma560 fk --q joint1=0,0,0,0,0,0"
+  # Issue 20: --offchain names a joint the arm has no moving joint off the chain of, a value that is
+  # not a finite number or outside the joint's limits, a joint twice, or a robot without a URDF.
+  "--robot ${DATA}/jaw_arm.urdf --offchain nosuch=0 fk --q 0,0,0,0,0,0 => --offchain: there is no joint 'nosuch' \\(moving joints off the chain: jointGripper\\) in .*jaw_arm.urdf$"
+  "--robot ${DATA}/jaw_arm.urdf --offchain jointGripper=0.5 fk --q 0,0,0,0,0,0 => --offchain: joint 'jointGripper': 0.5 rad is outside its limits -1.57 .. 0 rad"
+  "--robot ${DATA}/jaw_arm.urdf --offchain jointGripper=nan fk --q 0,0,0,0,0,0 => --offchain: 'nan' is not a finite number"
+  "--robot ${DATA}/jaw_arm.urdf --offchain jointGripper fk --q 0,0,0,0,0,0 => --offchain: 'jointGripper' is not a name=value pair"
+  "--robot ${DATA}/jaw_arm.urdf --offchain joint2=0.1 fk --q 0,0,0,0,0,0 => --offchain: joint 'joint2' is a joint of the arm, not off the chain"
+  "--robot ${DATA}/jaw_arm.urdf --offchain jointGripper=-1,jointGripper=-0.5 fk --q 0,0,0,0,0,0 => --offchain: joint 'jointGripper' is given twice"
+  "--robot puma560 --offchain jointGripper=0 fk --q 0,0,0,0,0,0 => --offchain applies to URDF robots only")
 set(count 0)
 foreach(args IN LISTS cases)
+  # "ARGS => REGEX": the message must also match REGEX.
+  set(expect "")
+  string(FIND "${args}" " => " arrow)
+  if(NOT arrow EQUAL -1)
+    math(EXPR after "${arrow} + 4")
+    string(SUBSTRING "${args}" ${after} -1 expect)
+    string(SUBSTRING "${args}" 0 ${arrow} args)
+  endif()
   set(shown "${args}")
   separate_arguments(argv UNIX_COMMAND "${shown}")
   execute_process(COMMAND ${PROGRAM} ${argv} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 60)
@@ -43,9 +60,12 @@ foreach(args IN LISTS cases)
   if(NOT rc EQUAL 2 OR NOT newline EQUAL -1 OR NOT err MATCHES "^rp-model: ")
     message(FATAL_ERROR "rp-model ${shown}: status ${rc}, stderr '${err}'")
   endif()
+  if(NOT expect STREQUAL "" AND NOT err MATCHES "${expect}")
+    message(FATAL_ERROR "rp-model ${shown}: stderr '${err}' does not match '${expect}'")
+  endif()
   message("rp-model ${shown} -> ${err}")
   math(EXPR count "${count} + 1")
 endforeach()
-if(NOT count EQUAL 26)
-  message(FATAL_ERROR "${count} cases ran, expected 26")
+if(NOT count EQUAL 33)
+  message(FATAL_ERROR "${count} cases ran, expected 33")
 endif()

@@ -55,7 +55,7 @@ void compareWithMuJoCo(const ManipulatorModel& model) {
   const int n = model.getNumberOfJoints();
   ASSERT_EQ(mj->m->nq, n);
   ASSERT_EQ(mj->m->nv, n);
-  // The tree: world, base_link, link1 .. linkN, each the parent of the next, one joint each.
+  // The tree: world, base_link, then the model's links, each the parent of the next, one joint each.
   ASSERT_EQ(mj->m->nbody, n + 2);
   for (int b = 1; b < n + 2; ++b) EXPECT_EQ(mj->m->body_parentid[b], b - 1);
   EXPECT_EQ(mj->m->body_jntnum[1], 0);
@@ -65,6 +65,9 @@ void compareWithMuJoCo(const ManipulatorModel& model) {
   ASSERT_GE(tool, 0);
   for (int i = 0; i < n; ++i) {
     const LinkParameters& l = model.getLink(i);
+    // The model's names (a URDF arm's own, joint1.../link1... for the built-in arms).
+    EXPECT_STREQ(mj_id2name(mj->m, mjOBJ_JOINT, i), model.getJointName(i).c_str());
+    EXPECT_STREQ(mj_id2name(mj->m, mjOBJ_BODY, i + 2), model.getLinkName(i).c_str());
     EXPECT_EQ(mj->m->jnt_bodyid[i], i + 2);
     EXPECT_EQ(mj->m->jnt_type[i], model.isPrismatic(i) ? mjJNT_SLIDE : mjJNT_HINGE);
     EXPECT_EQ(mj->m->jnt_limited[i], 1);

@@ -1,11 +1,12 @@
 // URDF chains are loaded exactly, whatever their axes: the project's own test descriptions (float
 // noise in axes, nearly parallel, nearly intersecting and coincident axes, fixed-frame branches,
-// prismatic joints) against Orocos KDL built from the same file through urdfdom (each joint's
-// origin, then its motion about or along its axis, the way kdl_parser builds a chain; the inertia
-// of links fixed to a chain link off the chain added to it with KDL's own arithmetic), at random
-// configurations: forward kinematics, Jacobian, gravity, inverse dynamics and mass matrix to 1e-12
-// relative. And a sweep: every leaf link of every test description as the tip either loads and
-// agrees with KDL, or is refused with a message naming the file; never a NaN.
+// prismatic joints, mimic joints, fingers and a jaw off the chain) against Orocos KDL built from
+// the same file by kdl_parser (Debian's libkdl-parser-dev, KdlFromUrdf.hpp: treeFromFile, then the
+// tree's chain to the tip, the subtrees off the chain lumped with KDL's own arithmetic, mimic
+// joints at multiplier * master + offset), at random configurations: forward kinematics,
+// Jacobian, gravity, inverse dynamics and mass matrix to 1e-12 relative. And a sweep: every leaf
+// link of every test description as the tip either loads and agrees with KDL, or is refused with a
+// message naming the file; never a NaN.
 #include <gtest/gtest.h>
 
 #include <urdf_parser/urdf_parser.h>
@@ -21,10 +22,12 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 
 #include "KdlChain.hpp"
+#include "KdlFromUrdf.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "UrdfDom.hpp"
@@ -38,90 +41,8 @@ const std::string kData = RP_TEST_DATA_DIR;
 using test::parse;
 using test::pose;
 
-KDL::RigidBodyInertia kdlInertia(const urdf::Inertial& i) {
-  const Transform T = pose(i.origin);
-  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
-  Eigen::Matrix3d I;
-  I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
-  const Eigen::Matrix3d Il = R * I * R.transpose();
-  return KDL::RigidBodyInertia(i.mass, KDL::Vector(T(0, 3), T(1, 3), T(2, 3)),
-                               KDL::RotationalInertia(Il(0, 0), Il(1, 1), Il(2, 2), Il(0, 1), Il(0, 2), Il(1, 2)));
-}
-
-// The chain root -> tip of a URDF as KDL segments, and how many movable joints it has.
-struct KdlArm {
-  KDL::Chain chain;
-  int joints = 0;
-  bool allInertial = true;  // the child link of every movable joint has inertial data
-  // Per movable chain joint: the independent joint that moves it (its own name unless a mimic,
-  // mimics of mimics followed to the end), and the multiplier and offset from it.
-  std::vector<std::string> master;
-  std::vector<double> multiplier, offset;
-};
-
-// The value at which a moving joint off the chain is lumped: zero within its limits, or for a
-// mimic joint its master's times the multiplier plus the offset.
-double offChainValue(const urdf::ModelInterfaceSharedPtr& robot, const urdf::JointConstSharedPtr& j) {
-  if (j->mimic) return j->mimic->multiplier * offChainValue(robot, robot->getJoint(j->mimic->joint_name)) + j->mimic->offset;
-  return j->limits && j->type != urdf::Joint::CONTINUOUS ? std::clamp(0.0, j->limits->lower, j->limits->upper) : 0.0;
-}
-
-KdlArm kdlArm(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip) {
-  std::vector<urdf::JointConstSharedPtr> joints;
-  for (auto link = robot->getLink(tip); link->parent_joint; link = robot->getLink(link->parent_joint->parent_link_name))
-    joints.push_back(link->parent_joint);
-  std::reverse(joints.begin(), joints.end());
-  std::set<std::string> onChain;
-  for (const auto& j : joints) onChain.insert(j->child_link_name);
-  KdlArm arm;
-  for (const urdf::JointConstSharedPtr& j : joints) {
-    const KDL::Frame origin = test::kdlFrame(pose(j->parent_to_joint_origin_transform));
-    // The child link's inertia and that of the links fixed to it off the chain.
-    KDL::RigidBodyInertia inertia = KDL::RigidBodyInertia::Zero();
-    bool any = false;
-    std::vector<std::pair<urdf::LinkConstSharedPtr, KDL::Frame>> todo{{robot->getLink(j->child_link_name), KDL::Frame::Identity()}};
-    while (!todo.empty()) {
-      const auto [link, frame] = todo.back();
-      todo.pop_back();
-      if (link->inertial) {
-        inertia = inertia + frame * kdlInertia(*link->inertial);
-        any = true;
-      }
-      for (const urdf::JointSharedPtr& c : link->child_joints) {
-        if (onChain.count(c->child_link_name)) continue;
-        const KDL::Frame o = test::kdlFrame(pose(c->parent_to_joint_origin_transform));
-        if (c->type == urdf::Joint::FIXED) {
-          todo.emplace_back(robot->getLink(c->child_link_name), frame * o);
-        } else if (c->type != urdf::Joint::FLOATING && c->type != urdf::Joint::PLANAR) {
-          // A moving link off the chain (a finger, a jaw), lumped at its stated value.
-          KDL::Vector axis = o.M * KDL::Vector(c->axis.x, c->axis.y, c->axis.z);
-          axis = axis / axis.Norm();
-          const KDL::Joint joint(c->name, o.p, axis, c->type == urdf::Joint::PRISMATIC ? KDL::Joint::TransAxis : KDL::Joint::RotAxis);
-          todo.emplace_back(robot->getLink(c->child_link_name), frame * KDL::Segment(joint, o).pose(offChainValue(robot, c)));
-        }
-      }
-    }
-    if (j->type == urdf::Joint::FIXED) {
-      arm.chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, KDL::Joint::Fixed), origin, inertia));
-    } else {
-      if (!any) arm.allInertial = false;
-      ++arm.joints;
-      double a = 1, b = 0;
-      urdf::JointConstSharedPtr m = j;
-      for (; m->mimic; m = robot->getJoint(m->mimic->joint_name)) {
-        b += a * m->mimic->offset;
-        a *= m->mimic->multiplier;
-      }
-      arm.master.push_back(m->name);
-      arm.multiplier.push_back(a);
-      arm.offset.push_back(b);
-      const KDL::Vector axis = origin.M * KDL::Vector(j->axis.x, j->axis.y, j->axis.z);
-      const KDL::Joint::JointType type = j->type == urdf::Joint::PRISMATIC ? KDL::Joint::TransAxis : KDL::Joint::RotAxis;
-      arm.chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, origin.p, axis / axis.Norm(), type), origin, inertia));
-    }
-  }
-  return arm;
-}
+using test::KdlArm;
+using test::kdlArm;
 
 // Largest difference between a and b relative to the largest entry of b (at least 1e-3, so that
 // a quantity that is nearly zero everywhere is compared absolutely).
@@ -211,17 +132,21 @@ Agreement compare(const ManipulatorModel& model, const KdlArm& arm, int trials, 
   return w;
 }
 
-std::unique_ptr<ManipulatorModel> load(const std::string& file, const std::string& tip) {
+std::unique_ptr<ManipulatorModel> load(const std::string& file, const std::string& tip,
+                                       const std::map<std::string, double>& offChain = {}) {
   UrdfOptions options;
   options.tip = tip;
+  options.offChainPositions = offChain;
   return loadUrdf(kData + "/" + file, options);
 }
 
-void expectExact(const std::string& file, const std::string& tip, int joints, int chainJoints = 0) {
+// `offChain`: values of joints off the chain (UrdfOptions::offChainPositions) for both.
+void expectExact(const std::string& file, const std::string& tip, int joints, int chainJoints = 0,
+                 const std::map<std::string, double>& offChain = {}) {
   SCOPED_TRACE(file + " to " + tip);
-  const std::unique_ptr<ManipulatorModel> model = load(file, tip);
+  const std::unique_ptr<ManipulatorModel> model = load(file, tip, offChain);
   ASSERT_EQ(model->getNumberOfJoints(), joints);
-  const KdlArm arm = kdlArm(parse(kData + "/" + file), tip);
+  const KdlArm arm = kdlArm(kData + "/" + file, parse(kData + "/" + file), tip, offChain);
   ASSERT_EQ(arm.joints, chainJoints > 0 ? chainJoints : joints);
   const Agreement w = compare(*model, arm, 300, 11);
   EXPECT_TRUE(w.finite);
@@ -248,6 +173,10 @@ TEST(UrdfExactness, ArmsWithFixedFrameBranchesAndPrismaticJointsLoadExactly) {
   expectExact("test_arm.urdf", "tool", 6);
   expectExact("panda_like.urdf", "link7", 7);  // the hand and the fingers (one a mimic) lumped
   expectExact("jaw_arm.urdf", "link06", 6);    // the jaw lumped
+  // Lumped where UrdfOptions::offChainPositions puts them: the jaw open, the fingers apart (the
+  // second, a mimic, following the first).
+  expectExact("jaw_arm.urdf", "link06", 6, 0, {{"jointGripper", -1.2}});
+  expectExact("panda_like.urdf", "link7", 7, 0, {{"finger_joint1", 0.03}});
   expectExact("prismatic_arm.urdf", "tool", 6);
 }
 
@@ -405,7 +334,7 @@ TEST(UrdfExactness, EveryLeafOfEveryTestDescriptionLoadsExactlyOrIsRefused) {
         continue;
       }
       ++loaded;
-      const KdlArm arm = kdlArm(robot, name);
+      const KdlArm arm = kdlArm(file, robot, name);
       ASSERT_EQ(arm.joints, model->getChain().getNumberOfJoints());
       const Agreement w = compare(*model, arm, 40, 5);
       EXPECT_TRUE(w.finite);

@@ -1,13 +1,14 @@
 // The URDF export read back with urdfdom (walking its joints gives the model's forward
 // kinematics), loaded by MuJoCo (Debian's libmujoco-dev, linked into this test only: its mass
 // matrix and bias forces equal the model's), and reloaded with rp's own loader (the same arm but
-// for what URDF cannot carry).
+// for what URDF cannot carry; a loaded URDF keeps its joint and link names).
 #include <gtest/gtest.h>
 
 #include <urdf_parser/urdf_parser.h>
 
 #include <fstream>
 #include <random>
+#include <set>
 
 #include "MuJoCo.hpp"
 #include "rp/model/Dynamics.hpp"
@@ -124,6 +125,115 @@ TEST(UrdfExport, MuJoCoLoadsTheExportsWithTheModelsDynamics) {
   compareUrdfWithMuJoCo(Puma560Model(0.67183, translation(1, 2, 0) * zRotation(0.5), translation(0, 0, 0.1)));
   compareUrdfWithMuJoCo(WAM7Model());
   compareUrdfWithMuJoCo(WAM4Model());
+}
+
+// A URDF loaded and exported keeps its names (issue 20: the ROS 2 bridge publishes joint_states with
+// the names of its robot_description). The export read back with urdfdom has the original chain's
+// movable joints, in order, each moving the model's link and hanging on the previous one; reloaded
+// with loadUrdf() it is the same arm: the same names, forward kinematics, Jacobian, gravity, inverse
+// dynamics and mass matrix at random configurations (1e-12 relative).
+void checkNamesKept(const std::string& file, const std::string& tip) {
+  SCOPED_TRACE(file + " to " + tip);
+  UrdfOptions options;
+  options.tip = tip;
+  options.requireDynamics = true;
+  const std::unique_ptr<ManipulatorModel> model = loadUrdf(std::string(RP_TEST_DATA_DIR) + "/" + file, options);
+  const int n = model->getNumberOfJoints();
+  // The original's movable joints from the root to the tip, and the links they move.
+  std::ifstream in(std::string(RP_TEST_DATA_DIR) + "/" + file);
+  const std::string original((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const urdf::ModelInterfaceSharedPtr source = urdf::parseURDF(original);
+  ASSERT_TRUE(source);
+  std::vector<std::string> joints, links;
+  for (auto link = source->getLink(tip); link->parent_joint; link = source->getLink(link->parent_joint->parent_link_name)) {
+    if (link->parent_joint->type == urdf::Joint::FIXED) continue;
+    joints.insert(joints.begin(), link->parent_joint->name);
+    links.insert(links.begin(), link->parent_joint->child_link_name);
+  }
+  ASSERT_EQ(static_cast<int>(joints.size()), n);
+
+  const std::string xml = toUrdf(*model);
+  const urdf::ModelInterfaceSharedPtr exported = urdf::parseURDF(xml);
+  ASSERT_TRUE(exported) << xml;
+  std::string parent = "base_link";
+  for (int k = 0; k < n; ++k) {
+    const urdf::JointConstSharedPtr j = exported->getJoint(joints[static_cast<std::size_t>(k)]);
+    ASSERT_TRUE(j) << joints[static_cast<std::size_t>(k)] << " is not in the export:\n" << xml;
+    EXPECT_EQ(j->child_link_name, links[static_cast<std::size_t>(k)]);
+    EXPECT_EQ(j->parent_link_name, parent);
+    EXPECT_EQ(j->type, model->isPrismatic(k) ? urdf::Joint::PRISMATIC : urdf::Joint::REVOLUTE);
+    parent = j->child_link_name;
+  }
+  EXPECT_EQ(exported->getJoint("tool")->parent_link_name, parent);
+  EXPECT_EQ(exported->joints_.size(), static_cast<std::size_t>(n + 2));  // and the fixed base and tool joints
+
+  const std::string path = testing::TempDir() + "/names_kept_" + file;
+  std::ofstream(path) << xml;
+  UrdfOptions again;
+  again.tip = "tool";
+  again.requireDynamics = true;
+  const std::unique_ptr<ManipulatorModel> back = loadUrdf(path, again);
+  ASSERT_EQ(back->getNumberOfJoints(), n);
+  for (int k = 0; k < n; ++k) {
+    EXPECT_EQ(back->getJointName(k), joints[static_cast<std::size_t>(k)]);
+    EXPECT_EQ(back->getLinkName(k), links[static_cast<std::size_t>(k)]);
+  }
+  ManipulatorData a(*model), b(*back);
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(0, 1);
+  double worstPose = 0, worstJ = 0, worstG = 0, worstTau = 0, worstM = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    JointVector q(n), qd(n), qdd(n), g1(n), g2(n);
+    for (int i = 0; i < n; ++i) {
+      q(i) = model->getPositionMin()(i) + u(rng) * (model->getPositionMax()(i) - model->getPositionMin()(i));
+      qd(i) = 2 * u(rng) - 1;
+      qdd(i) = 4 * u(rng) - 2;
+    }
+    worstPose = std::max(worstPose, test::relativeError(forwardKinematics(*back, b, q), forwardKinematics(*model, a, q)));
+    worstJ = std::max(worstJ, test::relativeError(jacobian(*back, b, q), jacobian(*model, a, q)));
+    gravityTorque(*back, b, q, g1);
+    gravityTorque(*model, a, q, g2);
+    worstG = std::max(worstG, test::relativeError(g1, g2));
+    worstTau = std::max(worstTau, test::relativeError(inverseDynamics(*back, b, q, qd, qdd), inverseDynamics(*model, a, q, qd, qdd)));
+    worstM = std::max(worstM, test::relativeError(massMatrix(*back, b, q), massMatrix(*model, a, q)));
+  }
+  std::printf("%s to %s exported and reloaded: names kept; fk %.1e, J %.1e, g %.1e, tau %.1e, M %.1e relative\n",
+              file.c_str(), tip.c_str(), worstPose, worstJ, worstG, worstTau, worstM);
+  EXPECT_LT(worstPose, 1e-12);
+  EXPECT_LT(worstJ, 1e-12);
+  EXPECT_LT(worstG, 1e-12);
+  EXPECT_LT(worstTau, 1e-12);
+  EXPECT_LT(worstM, 1e-12);
+}
+
+TEST(UrdfExport, ALoadedDescriptionKeepsItsJointAndLinkNames) {
+  checkNamesKept("ur_like.urdf", "tool0");
+  checkNamesKept("panda_like.urdf", "link7");  // the hand and the fingers lumped into link7
+  checkNamesKept("prismatic_arm.urdf", "tool");  // a joint and a link both called 'lift'
+  checkNamesKept("test_arm.urdf", "tool");
+}
+
+// The frames the export adds (world, base_link, tool and the fixed joints base and tool) are renamed
+// where the model has a link or joint of that name: urdfdom refuses two links of one name.
+TEST(UrdfExport, AddedFramesAvoidTheModelsNames) {
+  const Puma560Model puma;
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < 6; ++i) links.push_back(puma.getLink(i));
+  links[0].linkName = "world";
+  links[1].linkName = "base_link";
+  links[2].linkName = "tool";
+  links[3].jointName = "base";
+  links[4].jointName = "tool_2";
+  const ManipulatorModel model("clashing", links);
+  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(toUrdf(model));
+  ASSERT_TRUE(urdf) << toUrdf(model);
+  EXPECT_EQ(urdf->getRoot()->name, "world_2");
+  EXPECT_EQ(urdf->getJoint("base_2")->child_link_name, "base_link_2");
+  EXPECT_EQ(urdf->getJoint("joint1")->child_link_name, "world");
+  EXPECT_EQ(urdf->getJoint("joint1")->parent_link_name, "base_link_2");
+  EXPECT_EQ(urdf->getJoint("tool_3")->child_link_name, "tool_3");
+  EXPECT_EQ(urdf->getJoint("tool_3")->parent_link_name, "link6");
+  EXPECT_EQ(urdf->getJoint("base")->child_link_name, "link4");
 }
 
 // A name with XML's special characters (a URDF robot's name may have any) is escaped.

@@ -1,5 +1,5 @@
 // Loading arms from URDF: forward kinematics against a direct walk of the URDF (urdfdom),
-// dynamics against Orocos KDL built from the same URDF with KDL's own API, a round trip through
+// dynamics against Orocos KDL built from the same URDF by kdl_parser, a round trip through
 // the exporter, and clear errors for bad files.
 #include <gtest/gtest.h>
 
@@ -17,10 +17,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <numbers>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 #include "KdlChain.hpp"
+#include "KdlFromUrdf.hpp"
 #include "ModifiedDh.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
@@ -46,43 +50,6 @@ std::vector<urdf::JointConstSharedPtr> chainTo(const urdf::ModelInterfaceSharedP
   return chain;
 }
 
-using test::kdlFrame;
-
-KDL::RigidBodyInertia kdlInertia(const urdf::Inertial& i) {
-  const Transform T = pose(i.origin);
-  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
-  Eigen::Matrix3d I;
-  I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
-  const Eigen::Matrix3d Il = R * I * R.transpose();
-  return KDL::RigidBodyInertia(i.mass, KDL::Vector(T(0, 3), T(1, 3), T(2, 3)),
-                               KDL::RotationalInertia(Il(0, 0), Il(1, 1), Il(2, 2), Il(0, 1), Il(0, 2), Il(1, 2)));
-}
-
-// The KDL chain of the URDF, the way kdl_parser builds it (revolute joints about, prismatic joints
-// along their axis); the camera (fixed to l3, off the chain)
-// is added to l3's inertia.
-KDL::Chain kdlFromUrdf(const urdf::ModelInterfaceSharedPtr& robot, const std::string& tip) {
-  KDL::Chain chain;
-  for (const urdf::JointConstSharedPtr& j : chainTo(robot, tip)) {
-    const KDL::Frame origin = kdlFrame(pose(j->parent_to_joint_origin_transform));
-    const urdf::LinkConstSharedPtr child = robot->getLink(j->child_link_name);
-    KDL::RigidBodyInertia inertia = child->inertial ? kdlInertia(*child->inertial) : KDL::RigidBodyInertia::Zero();
-    for (const urdf::JointSharedPtr& c : child->child_joints) {
-      if (c->child_link_name == "camera") {
-        inertia = inertia + kdlFrame(pose(c->parent_to_joint_origin_transform)) * kdlInertia(*robot->getLink("camera")->inertial);
-      }
-    }
-    if (j->type == urdf::Joint::FIXED) {
-      chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, KDL::Joint::Fixed), origin, inertia));
-    } else {
-      const KDL::Vector axis = origin.M * KDL::Vector(j->axis.x, j->axis.y, j->axis.z);
-      const KDL::Joint::JointType type = j->type == urdf::Joint::PRISMATIC ? KDL::Joint::TransAxis : KDL::Joint::RotAxis;
-      chain.addSegment(KDL::Segment(j->child_link_name, KDL::Joint(j->name, origin.p, axis, type), origin, inertia));
-    }
-  }
-  return chain;
-}
-
 TEST(UrdfModel, ForwardKinematicsAndDynamicsMatchUrdfdomAndKdl) {
   UrdfOptions options;
   options.tip = "tool";
@@ -93,7 +60,7 @@ TEST(UrdfModel, ForwardKinematicsAndDynamicsMatchUrdfdomAndKdl) {
   EXPECT_DOUBLE_EQ(model->getTorqueLimit()(0), 80);
   EXPECT_DOUBLE_EQ(model->getPositionMax()(1), 2.0);
   const urdf::ModelInterfaceSharedPtr robot = parse(kData + "/test_arm.urdf");
-  const KDL::Chain chain = kdlFromUrdf(robot, "tool");
+  const KDL::Chain chain = test::kdlArm(kData + "/test_arm.urdf", robot, "tool").chain;  // the camera lumped into l3
   KDL::ChainIdSolver_RNE id(chain, KDL::Vector(0, 0, -9.81));
   KDL::ChainJntToJacSolver jac(chain);
   KDL::ChainDynParam dyn(chain, KDL::Vector(0, 0, -9.81));
@@ -161,7 +128,7 @@ TEST(UrdfModel, PrismaticJointsMatchUrdfWalkAndKdl) {
   EXPECT_DOUBLE_EQ(model->getPositionMax()(3), 0.35);
   EXPECT_DOUBLE_EQ(model->getTorqueLimit()(1), 300);
   const urdf::ModelInterfaceSharedPtr robot = parse(kData + "/prismatic_arm.urdf");
-  const KDL::Chain chain = kdlFromUrdf(robot, "tool");
+  const KDL::Chain chain = test::kdlArm(kData + "/prismatic_arm.urdf", robot, "tool").chain;
   KDL::ChainFkSolverPos_recursive fk(chain);
   KDL::ChainIdSolver_RNE id(chain, KDL::Vector(0, 0, -9.81));
   KDL::ChainJntToJacSolver jac(chain);
@@ -318,14 +285,15 @@ TEST(UrdfModel, DefaultTipIgnoresBranchesOfFixedFramesAndStopsBeforeGrippers) {
   EXPECT_EQ(model->getLinkName(5), "link06");
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_EQ(notes[0], kData + "/jaw_arm.urdf: links 'gripperMover' move off the chain: their mass is lumped into 'link06' "
-                              "at jointGripper = 0 (UrdfOptions::offChainPositions sets other values)");
+                              "at jointGripper = 0 rad (other values: UrdfOptions::offChainPositions, rp.cfg "
+                              "offChainPositions, rp-model --offchain)");
   notes.clear();
   model = loadUrdf(kData + "/panda_like.urdf", options);
   ASSERT_EQ(model->getNumberOfJoints(), 7);
   EXPECT_EQ(model->getLinkName(6), "link7");
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("links 'leftfinger', 'rightfinger' move off the chain: their mass is lumped into 'link7' at "
-                          "finger_joint1 = 0, finger_joint2 = 0"),
+                          "finger_joint1 = 0 m, finger_joint2 = 0 m"),
             std::string::npos)
       << notes[0];
 }
@@ -392,7 +360,7 @@ TEST(UrdfModel, MovingLinksOffTheChainAreLumpedAtTheStatedConfiguration) {
   open.notes = &notes;
   const std::unique_ptr<ManipulatorModel> a = loadUrdf(f, open);
   ASSERT_EQ(notes.size(), 1u);
-  EXPECT_NE(notes[0].find("finger_joint1 = 0.015, finger_joint2 = 0.04"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("finger_joint1 = 0.015 m, finger_joint2 = 0.04 m"), std::string::npos) << notes[0];
   const std::unique_ptr<ManipulatorModel> closed = loadUrdf(kData + "/panda_like.urdf");
   // Finger masses 0.015 each, hand rotated -45 deg about z in link7: the fingers open along the
   // hand's y axis by 0.015 (left, +y) and 0.04 (right, -y).
@@ -408,6 +376,55 @@ TEST(UrdfModel, MovingLinksOffTheChainAreLumpedAtTheStatedConfiguration) {
   EXPECT_EQ(error(kData + "/panda_like.urdf", "rightfinger"),
             kData + "/panda_like.urdf: joint 'finger_joint2' mimics joint 'finger_joint1', which is not a joint of the "
                     "chain; a mimic joint on the chain follows a joint of the chain");
+}
+
+// UrdfOptions::offChainPositions: each entry must name a moving joint off the chain that moves a
+// lumped link, with a finite value within its limits; else UrdfOptionError names the file, the
+// option and the joint (and lists the moving joints off the chain). In rp.cfg's units (degrees
+// and millimetres) the same positions lump the same masses.
+TEST(UrdfModel, OffChainPositionsAreCheckedAndNamed) {
+  const std::string jaw = kData + "/jaw_arm.urdf", panda = kData + "/panda_like.urdf";
+  auto error = [](const std::string& file, const std::map<std::string, double>& positions, bool degrees = false) {
+    UrdfOptions o;
+    o.offChainPositions = positions;
+    o.offChainInDegreesAndMillimetres = degrees;
+    try {
+      loadUrdf(file, o);
+    } catch (const UrdfOptionError& e) {
+      EXPECT_EQ(e.option(), "offChainPositions");
+      EXPECT_EQ(std::string(e.what()), file + ": UrdfOptions::offChainPositions: " + e.problem());
+      return e.problem();
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error(jaw, {{"jointGripper", -1.2}}), "no error");
+  EXPECT_EQ(error(jaw, {{"nosuch", 0}}), "there is no joint 'nosuch' (moving joints off the chain: jointGripper)");
+  EXPECT_EQ(error(jaw, {{"jointGripper", std::nan("")}}), "joint 'jointGripper': the value is not finite");
+  EXPECT_EQ(error(jaw, {{"joint3", 0.1}}), "joint 'joint3' is a joint of the arm, not off the chain (moving joints off "
+                                           "the chain: jointGripper)");
+  EXPECT_EQ(error(jaw, {{"jointGripper", 0.5}}), "joint 'jointGripper': 0.5 rad is outside its limits -1.57 .. 0 rad");
+  EXPECT_EQ(error(jaw, {{"jointGripper", -100}}, true), "joint 'jointGripper': -100 deg is outside its limits -89.9544 .. 0 deg");
+  EXPECT_EQ(error(panda, {{"finger_joint1", 50}}, true), "joint 'finger_joint1': 50 mm is outside its limits 0 .. 40 mm");
+  EXPECT_EQ(error(panda, {{"joint8", 0}}), "joint 'joint8' is fixed, floating or planar: it has no position (moving "
+                                           "joints off the chain: finger_joint1, finger_joint2)");
+  // Degrees and millimetres: the same lumped masses as radians and metres.
+  for (const auto& [file, joint, si, cfg] : {std::tuple{jaw, "jointGripper", -1.2, -1.2 * 180 / std::numbers::pi},
+                                             std::tuple{panda, "finger_joint1", 0.03, 30.0}}) {
+    UrdfOptions a, b;
+    a.offChainPositions[joint] = si;
+    b.offChainPositions[joint] = cfg;
+    b.offChainInDegreesAndMillimetres = true;
+    const std::unique_ptr<ManipulatorModel> ma = loadUrdf(file, a), mb = loadUrdf(file, b), closed = loadUrdf(file);
+    const int last = ma->getNumberOfJoints() - 1;
+    // The lumped link's mass distribution: its first moment and inertia (the Panda's fingers open
+    // symmetrically, which keeps the centre of mass and changes the inertia).
+    auto differ = [&](const ManipulatorModel& x, const ManipulatorModel& y) {
+      const LinkParameters &l = x.getLink(last), &r = y.getLink(last);
+      return (Eigen::Vector3d(l.com) - Eigen::Vector3d(r.com)).norm() + (Eigen::Matrix3d(l.inertia) - Eigen::Matrix3d(r.inertia)).norm();
+    };
+    EXPECT_LT(differ(*ma, *mb), 1e-15) << file;
+    EXPECT_GT(differ(*ma, *closed), 1e-6) << file << ": the position changes the lumped link";
+  }
 }
 
 // A mimic joint on the chain that names a missing joint is refused, naming the file and both

@@ -2,6 +2,7 @@
 /// @file
 /// The `<visual>` elements of a URDF arm as shapes of its 3D model (drawn by the Scene Viewer).
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,12 @@ struct UrdfVisualOptions {
   /// deeper down, see resolveMeshUri()). The environment variable `ROS_PACKAGE_PATH` and the
   /// folders above the description are searched after these.
   std::vector<std::string> packagePath;
+  /// Where moving joints off the chain stand, as UrdfOptions::offChainPositions (checked the same
+  /// way; a UrdfOptionError for a bad entry): their links are drawn where loadUrdf() lumps them.
+  std::map<std::string, double> offChainPositions;
+  /// Whether offChainPositions are in degrees and millimetres, as
+  /// UrdfOptions::offChainInDegreesAndMillimetres.
+  bool offChainInDegreesAndMillimetres = false;
 };
 
 /// One `<visual>` element of a URDF link as the Scene Viewer draws it.
@@ -44,13 +51,13 @@ struct UrdfVisual {
 /// the chain (including links fixed to it) to frame `linkk` (with mimic joints on the chain: the
 /// k-th chain joint's frame `chaink`), with the constant pose of the visual in that frame. Links
 /// moved by joints off the chain (fingers, a jaw) go to the frame of the chain link they hang on,
-/// at the configuration where loadUrdf() lumps them by default (zero within the joint's limits, a
-/// mimic joint following its master).
+/// at the configuration where loadUrdf() lumps them: `options.offChainPositions`, else zero within
+/// the joint's limits, a mimic joint following its master.
 /// Boxes, cylinders (along z, as in URDF), spheres and meshes (scaled by `scale`) keep their
 /// sizes; mesh file names are resolved by resolveMeshUri(). Colours come from the visual's
 /// material or the robot's material of that name (default grey).
 /// @param[in] urdfFile  path of the URDF file
-/// @param[in] options   tip link and package path
+/// @param[in] options   tip link, package path and the positions of joints off the chain
 /// @return the visuals in file order (empty if the file has none)
 /// @throws UrdfError naming the file, as loadUrdf()
 /// Real-time safe: no.

@@ -16,10 +16,13 @@ struct MjcfOptions {
 };
 
 /// The MJCF text of `model`, which MuJoCo (2.2 and later) loads: a static body `base_link` at the
-/// base transform, then bodies `link1`..`linkN`, each with a hinge (revolute) or slide (prismatic)
-/// joint `joint1`..`jointN` about its z axis, a site `tool` at the end-effector, a torque motor
+/// base transform, then one body per joint named as the model's links (getLinkName(): a loaded
+/// URDF's own names, `link1`..`linkN` for the built-in arms), each with a hinge (revolute) or slide
+/// (prismatic) joint about its z axis named as the model's joint (getJointName(): the URDF's,
+/// `joint1`..`jointN` for the built-in arms), a site `tool` at the end-effector, a torque motor
 /// `motor1`..`motorN` per joint (control range = the torque limit) and a keyframe `home` at the
-/// model's home position. Gravity is the model's.
+/// model's home position (`base_link_2`, `tool_2`, ... where the model has a link or joint of
+/// that name). Gravity is the model's.
 ///
 /// The bodies are the frames URDF link k of toUrdf() uses (the joint frame after the joint's
 /// motion), so forward kinematics equals the model's. Each joint carries its range (`limited`),

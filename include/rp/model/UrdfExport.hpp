@@ -9,9 +9,17 @@
 
 namespace rp {
 
-/// The URDF text of `model`: links `base_link`, `link1`..`linkN` and `tool`, revolute or
-/// prismatic joints `joint1`..`jointN` with the model's limits (effort = torque limit, velocity limit), inertias
-/// at each link's centre of mass, and fixed joints for the base and tool transforms.
+/// The URDF text of `model`: links `world`, `base_link`, one per joint named as the model's
+/// links (getLinkName(): a loaded URDF's own names, `link1`..`linkN` for the built-in arms) and
+/// `tool`; revolute or prismatic joints named as the model's joints (getJointName(): the URDF's,
+/// `joint1`..`jointN` for the built-in arms) with the model's limits (effort = torque limit,
+/// velocity limit), inertias at each link's centre of mass, and fixed joints `base` and `tool` for
+/// the base and tool transforms. A URDF loaded and exported so keeps its joint names (and those
+/// of the links the joints move); the frames the export adds are renamed `world_2`, `tool_2`, ...
+/// where the model has a link or joint of that name. What is not kept: the root and tip link
+/// names (the export's `base_link` and `tool`), links fixed to the chain (their mass is in the link
+/// they hang on) and, where a joint's axis is not z, the orientation of its link's frame: link
+/// frame k is the model's, turned so that its z axis is the joint axis (see loadUrdf()).
 ///
 /// Dynamics: the inertial data are those of physicalModel() (MuJoCo and Drake refuse a massless link
 /// with inertia and inertias that break the triangle inequality, as the Puma 560's published ones

@@ -20,6 +20,27 @@ class UrdfError : public std::runtime_error {
   explicit UrdfError(const std::string& message) : std::runtime_error(message) {}
 };
 
+/// Error in a value the caller gave in UrdfOptions (not in the file), such as a joint of
+/// UrdfOptions::offChainPositions the description has no such (moving, off-chain) joint of: what()
+/// starts with the file name, and option() and problem() let a caller say where the value came
+/// from (an rp.cfg setting, a command-line option).
+class UrdfOptionError : public UrdfError {
+ public:
+  /// Creates the error.
+  /// @param[in] fileName  the URDF file
+  /// @param[in] option    the option at fault, e.g. `offChainPositions`
+  /// @param[in] problem   what is wrong with it, naming the joint
+  UrdfOptionError(const std::string& fileName, const std::string& option, const std::string& problem)
+      : UrdfError(fileName + ": UrdfOptions::" + option + ": " + problem), option_(option), problem_(problem) {}
+  /// The option at fault, e.g. `offChainPositions`.
+  const std::string& option() const noexcept { return option_; }
+  /// What is wrong, without the file name and option, e.g. `there is no joint 'x' (...)`.
+  const std::string& problem() const noexcept { return problem_; }
+
+ private:
+  std::string option_, problem_;
+};
+
 /// Options of loadUrdf().
 struct UrdfOptions {
   /// Last link of the chain. Empty: from the root, follow the one child joint below which
@@ -34,9 +55,15 @@ struct UrdfOptions {
   /// the chain it lumped, at which joint values); may be null.
   std::vector<std::string>* notes = nullptr;
   /// Values of moving joints off the chain (fingers, a jaw) at which the links they move are
-  /// lumped into the chain link they hang on, by joint name [rad or m]. A joint not named here is
-  /// at zero (within its limits); a mimic joint follows its master (multiplier and offset).
+  /// lumped into the chain link they hang on, by joint name [rad or m; deg or mm with
+  /// offChainInDegreesAndMillimetres]. A joint not named here is at zero (within its limits); a
+  /// mimic joint follows its master (multiplier and offset) unless it is named itself. Each name
+  /// must be a revolute, continuous or prismatic joint off the chain that moves links lumped into
+  /// the arm, and each value finite and within the joint's limits (UrdfOptionError otherwise).
   std::map<std::string, double> offChainPositions;
+  /// Whether offChainPositions are in rp.cfg's units: degrees for revolute and continuous joints,
+  /// millimetres for prismatic ones (UrdfManipulator's `offChainPositions` setting).
+  bool offChainInDegreesAndMillimetres = false;
 };
 
 /// Loads the serial chain from the URDF root link to a tip link as a ManipulatorModel.
@@ -70,7 +97,8 @@ struct UrdfOptions {
 ///         floating or planar joint in the chain, an unknown tip, a branching robot
 ///         without a tip, no movable joint, a number that is not finite (naming the joint or
 ///         link), a mimic joint naming a missing joint (or mimics in a circle), a mimic joint on
-///         the chain following a joint off it, and (with requireDynamics) a moving link without inertial data
+///         the chain following a joint off it, and (with requireDynamics) a moving link without inertial
+///         data; UrdfOptionError (a UrdfError) for a bad UrdfOptions::offChainPositions entry
 /// Real-time safe: no.
 std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options = UrdfOptions());
 
