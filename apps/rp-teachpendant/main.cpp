@@ -183,9 +183,21 @@ class Teachpendant : public rp::RoboticObject {
       // generator, disconnected from the arm, ends its waits).
       abort_ = true;
       if (busy()) {
-        auto brake = std::make_unique<Brake>(arm_.getModel(), arm_.getJointVelocity());
+        // The reply says where and how fast the arm was when the brake took over, and how hard
+        // each joint brakes: the page's own state frame may be a frame or more old by then.
+        const rp::JointVector q = arm_.getJointPosition(), qd = arm_.getJointVelocity();
+        auto brake = std::make_unique<Brake>(arm_.getModel(), qd);
         arm_.setTrajectoryGenerator(*brake);
         brake_ = std::move(brake);  // the previous brake, if any, after the arm left it
+        json from = {{"q", json::array()}, {"qd", json::array()}, {"deceleration", json::array()}};
+        for (Eigen::Index i = 0; i < q.size(); ++i) {
+          from["q"].push_back(q(i));
+          from["qd"].push_back(qd(i));
+          from["deceleration"].push_back(0.8 * arm_.getModel().getAccelerationLimit()(i));
+        }
+        json r = state();
+        r["brake"] = from;
+        reply = r.dump();
       }
     } else {
       return rp::RoboticObject::handleMessage(type, payload, reply);
