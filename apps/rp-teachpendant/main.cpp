@@ -54,7 +54,7 @@ class Brake : public rp::TrajectoryGenerator {
     started_ = false;
   }
   bool getCurrentSetpoint(double time, rp::Setpoint& setpoint) override {
-    if (!started_) {  // from the last setpoint (the position the motion had reached)
+    if (!started_) {  // from the hold the manipulator hands a new generator: where the arm is
       for (int i = 0; i < n_; ++i) p_[static_cast<std::size_t>(i)] = setpoint.position(i);
       lastTime_ = time;
       started_ = true;
@@ -118,8 +118,15 @@ class Teachpendant : public rp::RoboticObject {
     } else if (type == "zeroGravity") {
       if (!j.is_boolean()) throw std::invalid_argument("zeroGravity needs true or false");
       if (busy()) throw std::invalid_argument("the arm is moving to a stored position");
-      if (j.get<bool>()) arm_.setZeroGravityModeOn();
-      else arm_.setZeroGravityModeOff();
+      if (j.get<bool>()) {
+        // The last motion's generator (holding its target) or a Stop's brake, left set, would
+        // pull the arm back to its setpoint when zero-gravity mode ends: cleared, the arm is held
+        // where it is pushed to (the next motion starts there with a fresh generator).
+        arm_.clearTrajectoryGenerator();
+        arm_.setZeroGravityModeOn();
+      } else {
+        arm_.setZeroGravityModeOff();
+      }
     } else if (type == "push") {
       if (!arm_.isSimulationModeOn()) throw std::invalid_argument("pushing the arm from the browser works in simulation only");
       if (!j.is_object() || !j.contains("force") || !j["force"].is_array() || j["force"].size() != 3)

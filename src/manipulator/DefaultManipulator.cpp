@@ -276,7 +276,7 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
       throw std::runtime_error("manipulator '" + getName() + "': cannot read the joints: " + board_->lastError());
     }
   }
-  hold_ = q_;
+  hold_ = q_;  // (the loop's first cycle holds again, where it reads the arm)
   setpoint_.position = q_;
   std::snprintf(nameBuffer_, sizeof nameBuffer_, "%s", getName().c_str());
 
@@ -638,6 +638,7 @@ void DefaultManipulator::enterControl() {
   }
   power_ = powerRequested_.load();
   sim_->setBrakes(!power_);
+  activeControl_ = nullptr;  // a hand-over: the servo control starts (activate()), holding where the first cycle reads the arm
 }
 
 void DefaultManipulator::exitControl() {
@@ -693,8 +694,7 @@ void DefaultManipulator::control() {
   if (wantPower != power_ && phase == 0) {
     power_ = wantPower;
     sim_->setBrakes(!power_);
-    hold_ = board_ ? q_ : sim_->getPosition();
-    if (power_) activeControl_ = nullptr;  // activate() again below
+    if (power_) activeControl_ = nullptr;  // a hand-over: activate() again below, holding where the arm is
   }
   if (board_) {
     if (!readHardware(lastCycleTime_ >= 0 && t > lastCycleTime_ ? t - lastCycleTime_ : dt)) ioFailure("reading the encoders", 0);
@@ -720,18 +720,26 @@ void DefaultManipulator::control() {
     return finishCycle(t, dt);
   }
 
-  // 2. The setpoint: the trajectory generator's, or hold. Every hand-over (another servo control
-  // set or one released, zero-gravity mode ending, a generator released, the power coming on)
-  // holds the arm where it is in this cycle: bumpless, never back to a stale pose.
+  // 2. The setpoint: the trajectory generator's, or hold. Every hand-over holds the arm where it
+  // is in this cycle (the joints just read), never at a stale pose: the servo control in use
+  // starting (again): at the loop's first cycle (a program's start), when the power comes on,
+  // when zero-gravity mode ends, or another control set or one released; a trajectory generator
+  // set, replaced or released (a new generator's first call gets this hold as the setpoint it
+  // starts from); zero-gravity mode, and no power, hold wherever the arm goes.
   const bool zeroG = zeroGravity_.load(std::memory_order_relaxed);
+  // In zero-gravity mode no servo control runs: the one in use starts afresh (activate(), e.g. no
+  // integral wound up before) when the mode ends, as a newly set one does.
+  if (zeroG) activeControl_ = nullptr;
   const bool controlChanges = servoControl_.load(std::memory_order_acquire) != activeControl_;
+  TrajectoryGenerator* generator = generator_.load(std::memory_order_acquire);
+  const bool generatorChanges = generator != activeGenerator_;
+  activeGenerator_ = generator;
   // (The request is taken in every cycle: one left pending would move the hold a cycle later.)
   const bool holdRequested = holdHere_.exchange(false, std::memory_order_acq_rel);
-  if (!power_ || zeroG || controlChanges || holdRequested) hold_ = q_;
+  if (!power_ || zeroG || controlChanges || generatorChanges || holdRequested) hold_ = q_;
   setpoint_.position = hold_;
   setpoint_.velocity.setZero();
   setpoint_.acceleration.setZero();
-  TrajectoryGenerator* generator = generator_.load(std::memory_order_acquire);
   if (generator != nullptr && power_ && !zeroG && phase == 0) {
     executing_.store(generator, std::memory_order_seq_cst);
     // Re-check: a generator being released is not called any more.

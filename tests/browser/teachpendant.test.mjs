@@ -1,5 +1,6 @@
 // Browser test of rp-teachpendant (Figure 20): zero-gravity mode, pushing the simulated arm by
-// dragging its end-effector, storing positions, moving back to one, cycling through them.
+// dragging its end-effector, storing positions, moving back to one, cycling through them, and
+// zero-gravity mode after a motion leaving the arm where it was pushed to.
 import { describe, it } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
@@ -152,5 +153,35 @@ describe('rp-teachpendant', () => {
     const end = await ctx.page.evaluate(() => window.rp.conn.message('teachpendant', 'push', JSON.stringify({ force: [0, 0, 0] }))
       .then((x) => JSON.parse(x.reply)));
     assert.equal(end.pushing, false);
+  });
+
+  it('zero-gravity mode after a motion: switched off, the arm stays where it was pushed to', async () => {
+    // The last Go left its generator holding the stored position. In zero-gravity mode a push
+    // moves the arm; when the mode ends the arm must be held there. (Before, the generator left
+    // set took over again and pulled the arm straight back to the stored position.)
+    const send = (type, payload) => ctx.page.evaluate(([t, p]) =>
+      window.rp.conn.message('teachpendant', t, p).then((r) => JSON.parse(r.reply)), [type, payload]);
+    const atRest = () => waitInPage(ctx.page, () => {
+      const o = window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'puma');
+      return o.values.slice(6, 12).every((v) => Math.abs(v) < 1e-3);
+    }, null, 20000);
+    await atRest();
+    const before = await joints();
+    assert.equal((await send('zeroGravity', 'true')).zeroGravity, true);
+    // One push, not repeated: the program lets it lapse after 250 ms of its own time (a push
+    // repeated from here would last as long as this page's messages take on a loaded machine).
+    assert.equal((await send('push', JSON.stringify({ force: [20, 0, 0] }))).pushing, true);
+    const deadline = Date.now() + 20000;
+    while ((await send('read', '')).pushing && Date.now() < deadline) await sleep(20);
+    await atRest();
+    const pushed = await joints();
+    const moved = distance(before, pushed);
+    assert.ok(moved > 0.01, `the push moved the arm only ${moved} rad`);
+    assert.equal((await send('zeroGravity', 'false')).zeroGravity, false);
+    await sleep(1000);
+    await atRest();
+    const after = await joints();
+    assert.ok(distance(pushed, after) < 0.25 * moved,
+      `zero-gravity mode off moved the arm ${distance(pushed, after)} rad (back toward the stored position, ${moved} rad away)`);
   });
 });

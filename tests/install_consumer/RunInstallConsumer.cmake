@@ -19,9 +19,10 @@ endif()
 if(NOT "${out}" MATCHES "consumer: end-effector position 0.5 0.25 1")
   message(FATAL_ERROR "the consumer did not print its end-effector position")
 endif()
-# The installed copy on its own: the prefix moved elsewhere, a program run without
-# LD_LIBRARY_PATH serves the installed front end (check-relocated.sh says what it checks).
-execute_process(COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/check-relocated.sh ${prefix} ${WORK_DIR}/moved
+# The installed copy on its own: the prefix moved out of the build tree, a program run from it
+# without LD_LIBRARY_PATH and with the build and source trees hidden serves the installed front
+# end, or the folder RP_WEB_ROOT names (check-relocated.sh says what it checks).
+execute_process(COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/check-relocated.sh ${prefix} ${BUILD_DIR} ${SOURCE_DIR}
   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 message("${out}${err}")
 if(NOT rc EQUAL 0)

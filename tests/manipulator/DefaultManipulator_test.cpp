@@ -1,7 +1,8 @@
 // Manipulators in simulation mode on the platform's simulated clock: holding under gravity
 // compensation, switching servo controls mid-motion between two cycles, each kind of limit
 // violation shutting down in the cycle it happens, two arms at once, determinism, zero-gravity
-// mode, and an allocation-free servo cycle. (Step and trajectory tracking: Tracking_test.cpp.)
+// mode, bumpless hand-overs (one test each), and an allocation-free servo cycle. (Step and
+// trajectory tracking: Tracking_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -340,15 +341,65 @@ TEST_F(ManipulatorTest, PowerOffEngagesTheBrakes) {
   EXPECT_TRUE(puma.isArmPowerOn());
 }
 
+// A servo control that outputs nothing: gravity compensation alone holds the arm, so a push moves
+// it away from where the last hand-over held it.
+struct DoNothing : ServoControl {
+  ~DoNothing() override { releaseFromManipulator(); }
+  void calculate() override {}
+};
+
+// Wraps a servo control and records, in its first cycle, the setpoint it is given and the joints
+// read in that cycle.
+class FirstCycle : public ServoControl {
+ public:
+  explicit FirstCycle(ServoControl& inner) : inner_(inner) {}
+  ~FirstCycle() override { releaseFromManipulator(); }
+  void attach(Manipulator& m) override {
+    ServoControl::attach(m);
+    if (inner_.getManipulator() != &m) inner_.attach(m);
+  }
+  void activate() override { inner_.activate(); }
+  void calculate() override {
+    if (!recorded.load(std::memory_order_relaxed)) {
+      setpoint = d_manipulator->getSetpoint().position;
+      q = d_manipulator->getJointPosition();
+      recorded.store(true, std::memory_order_release);  // the test reads them after this
+    }
+    inner_.calculate();
+  }
+  JointVector setpoint, q;
+  std::atomic<bool> recorded{false};
+
+ private:
+  ServoControl& inner_;
+};
+
+// A push of `newtons` along +x at the end-effector for `cycles` cycles while `control` outputs
+// nothing, then 1.5 s for friction to stop the arm; returns the joints it rests at.
+JointVector pushAside(DefaultManipulator& arm, DoNothing& control, double newtons, std::uint64_t cycles) {
+  arm.setServoControl(control);
+  Vector<6> push;
+  push(0) = newtons;
+  arm.applyExternalWrench(push);
+  EXPECT_TRUE(arm.runCycles(cycles));
+  arm.clearExternalWrench();
+  EXPECT_TRUE(arm.runCycles(1500));
+  EXPECT_LT(arm.getJointVelocity().cwiseAbs().maxCoeff(), 1e-3) << "at rest";
+  return arm.getJointPosition();
+}
+
+// Where the end-effector is at joint positions `q` [m].
+Eigen::Vector3d tipAt(const Manipulator& arm, const JointVector& q) {
+  const ManipulatorModel& model = arm.getModel();
+  ManipulatorData data(model);
+  return forwardKinematics(model, data, q).topRightCorner<3, 1>();
+}
+
 TEST_F(ManipulatorTest, ReleasingAServoControlHoldsTheArmWhereItIsNotWhereItWas) {
   // A servo control that does nothing (gravity compensation only) while a 40 N push moves the arm
   // for 1 s, then the control is destroyed: the default control takes over holding the arm where
   // it is at that cycle. Before, it pulled the arm back to the pose of before the push and tripped
   // the torque limit ("joint 2 torque 237.202 N m exceeds the limit") every time.
-  struct DoNothing : ServoControl {
-    ~DoNothing() override { releaseFromManipulator(); }
-    void calculate() override {}
-  };
   Puma560 puma;
   simClock().pause();
   const Transform start = puma.getEndEffectorTransform();
@@ -405,16 +456,21 @@ TEST_F(ManipulatorTest, ReleasingATrajectoryGeneratorMidMotionHoldsTheArmWhereIt
 TEST_F(ManipulatorTest, ATrajectoryGeneratorAndAServoControlTakeOverFromWhereTheArmIs) {
   // Each hand-over gives the newcomer, in its first cycle, a setpoint at the arm's position then:
   // a generator starts from it, a servo control set while the arm was moved holds it there.
+  // (Here a control and zero-gravity mode's end come in the same cycle; the tests below make
+  // each hand-over alone.)
   struct FirstSetpoint : TrajectoryGenerator {
     ~FirstSetpoint() override { releaseFromManipulators(); }
+    void attach(Manipulator& m) override { arm = &m; }
     bool getCurrentSetpoint(double, Setpoint& sp) override {
       if (!recorded.load(std::memory_order_relaxed)) {
         first = sp.position;
-        recorded.store(true, std::memory_order_release);  // the test reads `first` after this
+        q = arm->getJointPosition();  // in the servo thread: this cycle's reading
+        recorded.store(true, std::memory_order_release);  // the test reads them after this
       }
       return false;  // hold
     }
-    JointVector first;
+    Manipulator* arm = nullptr;
+    JointVector first, q;
     std::atomic<bool> recorded{false};
   };
   struct Tracker : ServoControl {  // PD on the setpoint; records the first one it sees
@@ -456,7 +512,8 @@ TEST_F(ManipulatorTest, ATrajectoryGeneratorAndAServoControlTakeOverFromWhereThe
   ASSERT_TRUE(puma.runCycles(2));
   ASSERT_TRUE(generator.recorded.load(std::memory_order_acquire));
   ASSERT_EQ(generator.first.size(), 6);
-  EXPECT_LT((generator.first - held).cwiseAbs().maxCoeff(), 1e-12) << "the generator starts where the arm was held";
+  EXPECT_LT((generator.first - generator.q).cwiseAbs().maxCoeff(), 1e-12) << "the generator starts where the arm is";
+  EXPECT_LT((generator.first - held).cwiseAbs().maxCoeff(), 0.01) << "near where the control took over";
   ASSERT_TRUE(puma.runCycles(1000));
   // The arm was still coasting when the control took over: it stops near there (a stale hold
   // would pull it back toward the home position instead).
@@ -464,6 +521,204 @@ TEST_F(ManipulatorTest, ATrajectoryGeneratorAndAServoControlTakeOverFromWhereThe
   EXPECT_LT((puma.getJointPosition() - held).norm(), 0.5 * (held - home).norm()) << "held near the take-over";
   puma.clearTrajectoryGenerator();
   puma.releaseServoControl(tracker);
+  simClock().resume();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+// Hand-overs, one test each: the arm is away from where the last hand-over held it (a push moved
+// it while a do-nothing control was in use, or while the power was off), then one change alone
+// is made. Each must hold the arm where it is in the cycle the change is taken.
+
+TEST_F(ManipulatorTest, SettingAServoControlHoldsTheArmWhereItIsNotWhereItWas) {
+  // A 40 N push moves the arm for 1 s under a do-nothing control; then, alone, a position control
+  // of the program is set. Its first setpoint is where the arm is in its first cycle, and it holds
+  // the arm near there: no pull back to the hold of before the push (which saturates the torque
+  // and trips the arm, as releasing the control used to).
+  Puma560 puma;
+  simClock().pause();
+  const JointVector start = puma.getJointPosition();
+  DoNothing nothing;
+  const JointVector pushed = pushAside(puma, nothing, 40, 1000);
+  DefaultPositionControl position;
+  FirstCycle takeOver(position);
+  takeOver.attach(puma);
+  const std::uint64_t saturated = puma.getSaturatedCycleCount();
+  puma.setServoControl(takeOver);
+  ASSERT_TRUE(puma.runCycles(1));
+  ASSERT_TRUE(takeOver.recorded.load(std::memory_order_acquire));
+  EXPECT_LT((takeOver.setpoint - takeOver.q).cwiseAbs().maxCoeff(), 1e-12) << "the first setpoint is where the arm is";
+  ASSERT_TRUE(puma.runCycles(1000));
+  const Eigen::Vector3d before = tipAt(puma, start), atSwitch = tipAt(puma, pushed), now = tipAt(puma, puma.getJointPosition());
+  ASSERT_GT((atSwitch - before).norm(), 0.05) << "the push moved the arm";
+  EXPECT_LT((now - atSwitch).norm(), 0.25 * (atSwitch - before).norm()) << "held near where the control took over";
+  EXPECT_EQ(puma.getSaturatedCycleCount(), saturated) << "no torque at a limit";
+  EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+  puma.releaseServoControl(takeOver);
+  simClock().resume();
+}
+
+TEST_F(ManipulatorTest, SettingATrajectoryGeneratorStartsItWhereTheArmIs) {
+  // A 40 N push moves the arm under a do-nothing control; then, alone, a trajectory generator is
+  // set. Its first call gets, as the setpoint it starts from, the joints read in that cycle, not
+  // the hold of before the push: a ramp from there starts where the arm is.
+  struct RecordingRamp : test::JointRamp {
+    RecordingRamp() : test::JointRamp(0, 0.2) {}
+    ~RecordingRamp() override { releaseFromManipulators(); }
+    void attach(Manipulator& m) override { arm = &m; }
+    bool getCurrentSetpoint(double time, Setpoint& sp) override {
+      if (!recorded.load(std::memory_order_relaxed)) {
+        entry = sp.position;
+        q = arm->getJointPosition();  // in the servo thread: this cycle's reading
+      }
+      const bool given = test::JointRamp::getCurrentSetpoint(time, sp);
+      if (!recorded.load(std::memory_order_relaxed)) {
+        first = sp.position;
+        recorded.store(true, std::memory_order_release);  // the test reads them after this
+      }
+      return given;
+    }
+    Manipulator* arm = nullptr;
+    JointVector entry, first, q;
+    std::atomic<bool> recorded{false};
+  };
+  Puma560 puma;
+  simClock().pause();
+  const JointVector start = puma.getJointPosition();
+  DoNothing nothing;
+  const JointVector pushed = pushAside(puma, nothing, 40, 1000);
+  ASSERT_GT((pushed - start).cwiseAbs().maxCoeff(), 0.05) << "the push moved the arm";
+  RecordingRamp ramp;
+  puma.setTrajectoryGenerator(ramp);
+  ASSERT_TRUE(puma.runCycles(2));
+  ASSERT_TRUE(ramp.recorded.load(std::memory_order_acquire));
+  ASSERT_EQ(ramp.entry.size(), 6);
+  EXPECT_LT((ramp.entry - ramp.q).cwiseAbs().maxCoeff(), 1e-12) << "the generator is handed the arm's position";
+  EXPECT_LT((ramp.first - ramp.q).cwiseAbs().maxCoeff(), 1e-12) << "and its motion starts there";
+  EXPECT_GT((ramp.q - start).cwiseAbs().maxCoeff(), 0.05) << "away from the hold of before the push";
+  puma.clearTrajectoryGenerator();
+  puma.releaseServoControl(nothing);
+  ASSERT_TRUE(puma.runCycles(500));
+  simClock().resume();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, ZeroGravityModeOnMidMotionLetsTheArmCoastWithoutAJump) {
+  // A ramp drives joint 1 at 0.5 rad/s under the default control; mid-motion, alone, zero-gravity
+  // mode goes on. From that very cycle only the gravity torque goes out: no servo torque braking
+  // the moving arm or pulling it to a hold, and the ramp no longer drives it. The arm goes on
+  // under its own momentum until friction stops it, and floats there.
+  Puma560 puma;
+  simClock().pause();
+  test::JointRamp ramp(0, 0.5);
+  puma.setTrajectoryGenerator(ramp);
+  ASSERT_TRUE(puma.runCycles(1000));
+  const double speed = puma.getJointVelocity()(0), atSwitch = puma.getJointPosition()(0);
+  ASSERT_GT(speed, 0.4) << "joint 1 follows the ramp [rad/s]";
+  puma.setZeroGravityModeOn();
+  const ManipulatorModel& model = puma.getModel();
+  ManipulatorData data(model);
+  JointVector gravity = JointVector::Zero(6);
+  for (int k = 0; k < 100; ++k) {
+    ASSERT_TRUE(puma.runCycles(1));
+    const JointVector q = puma.getJointPosition(), tau = puma.getControlOutput();  // of the same cycle
+    gravityTorque(model, data, q, gravity);
+    EXPECT_LT((tau - gravity).cwiseAbs().maxCoeff(), 1e-9) << "cycle " << k + 1 << ": the gravity torque alone";
+    if (k == 0) {
+      EXPECT_GT(puma.getJointVelocity()(0), 0.95 * speed) << "the arm goes on at its speed";
+    }
+  }
+  ASSERT_TRUE(puma.runCycles(1000));
+  const double now = puma.getJointPosition()(0);
+  EXPECT_GT(now, atSwitch + 1e-3) << "it coasted on";
+  EXPECT_LT(now, atSwitch + 0.1) << "friction stopped it; the ramp (0.55 rad on by now) no longer drives it";
+  EXPECT_LT(puma.getJointVelocity().cwiseAbs().maxCoeff(), 1e-3) << "at rest";
+  puma.clearTrajectoryGenerator();
+  puma.setZeroGravityModeOff();
+  ASSERT_TRUE(puma.runCycles(100));
+  simClock().resume();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, ZeroGravityModeOffStartsTheServoControlAfreshWhereTheArmIs) {
+  // The default control holds the arm against a steady 20 N push (its integral takes the load);
+  // zero-gravity mode lets the push move the arm, the push ends and the arm comes to rest; then,
+  // alone, zero-gravity mode goes off. The control starts afresh where the arm is: its first
+  // output is the gravity torque, not the integral wound up against the push before.
+  Puma560 puma;
+  simClock().pause();
+  const ManipulatorModel& model = puma.getModel();
+  ManipulatorData data(model);
+  JointVector gravity = JointVector::Zero(6);
+  Vector<6> push;
+  push(0) = 20;
+  puma.applyExternalWrench(push);
+  ASSERT_TRUE(puma.runCycles(3000));
+  gravityTorque(model, data, puma.getJointPosition(), gravity);
+  const double against = (puma.getControlOutput() - gravity).cwiseAbs().maxCoeff();
+  ASSERT_GT(against, 5.0) << "the control holds the push [N m]";
+  puma.setZeroGravityModeOn();
+  ASSERT_TRUE(puma.runCycles(300));
+  puma.clearExternalWrench();
+  ASSERT_TRUE(puma.runCycles(1500));
+  const JointVector atSwitch = puma.getJointPosition();
+  ASSERT_LT(puma.getJointVelocity().cwiseAbs().maxCoeff(), 1e-3) << "at rest";
+  puma.setZeroGravityModeOff();
+  ASSERT_TRUE(puma.runCycles(1));
+  gravityTorque(model, data, puma.getJointPosition(), gravity);
+  EXPECT_LT((puma.getControlOutput() - gravity).cwiseAbs().maxCoeff(), 0.05 * against)
+      << "the first output is (nearly) the gravity torque alone";
+  ASSERT_TRUE(puma.runCycles(1000));
+  EXPECT_LT((puma.getJointPosition() - atSwitch).cwiseAbs().maxCoeff(), 1e-3) << "held where zero-gravity mode ended";
+  simClock().resume();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, AnArmWhoseSimulationStartsOffHomeIsHeldWhereItStarts) {
+  // rp.cfg starts the simulated arm 30 and -60 degrees away from its home position: the program's
+  // start holds it there, not at home.
+  RoboticPlatform::setConfiguration(
+      Configuration::parse("[puma]\nclass Puma560\nsimInitialPosition 0 30 -60 0 10 0\n", "rp.cfg"));
+  simClock().pause();
+  Puma560 puma("puma");
+  const double deg = std::numbers::pi / 180;
+  JointVector start(6);
+  start << 0, 30 * deg, -60 * deg, 0, 10 * deg, 0;
+  ASSERT_GT((start - puma.getModel().getHomePosition()).cwiseAbs().maxCoeff(), 1.0) << "off home [rad]";
+  ASSERT_TRUE(puma.runCycles(2000));
+  EXPECT_LT((puma.getJointPosition() - start).cwiseAbs().maxCoeff(), 1e-4) << "held where it started";
+  EXPECT_EQ(puma.getSaturatedCycleCount(), 0u) << "no torque at a limit";
+  simClock().resume();
+  EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+}
+
+TEST_F(ManipulatorTest, PoweringOnAnArmMovedWhilePoweredOffHoldsItWhereItIs) {
+  // Powered off, the brakes hold the joints with at most their torque limit: a 40 N m twist about
+  // the tool axis slips the wrist joints (25 N m) and turns them. Powered on again, the arm is
+  // held where it is then, not turned back to where it was held before the power went off.
+  Puma560 puma;
+  simClock().pause();
+  ASSERT_TRUE(puma.runCycles(10));
+  const JointVector before = puma.getJointPosition();
+  puma.disableArmPower();
+  ASSERT_TRUE(puma.runCycles(50));
+  ASSERT_FALSE(puma.isArmPowerOn());
+  const Transform tip = puma.getEndEffectorTransform();
+  Vector<6> twist;
+  for (int i = 0; i < 3; ++i) twist(3 + i) = 40 * tip(i, 2);  // about the tool's z axis [N m]
+  puma.applyExternalWrench(twist);
+  ASSERT_TRUE(puma.runCycles(100));
+  puma.clearExternalWrench();
+  ASSERT_TRUE(puma.runCycles(500));
+  const JointVector moved = puma.getJointPosition();
+  ASSERT_GT((moved - before).cwiseAbs().maxCoeff(), 0.05) << "the twist turned the wrist [rad]";
+  ASSERT_LT(puma.getJointVelocity().cwiseAbs().maxCoeff(), 1e-9) << "the brakes stopped it";
+  puma.enableArmPower();
+  ASSERT_TRUE(puma.runCycles(2000));
+  EXPECT_TRUE(puma.isArmPowerOn());
+  EXPECT_LT((puma.getJointPosition() - moved).cwiseAbs().maxCoeff(), 1e-3) << "held where the power came on";
+  EXPECT_EQ(puma.getSaturatedCycleCount(), 0u) << "no torque at a limit";
   simClock().resume();
   EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
 }

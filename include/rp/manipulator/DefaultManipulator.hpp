@@ -27,7 +27,7 @@ class SimulatedClock;
 /// is created (paper Figure 11). Every cycle:
 /// 1. read the joints (from the arm, or from the dynamic simulation in simulation mode);
 /// 2. get the setpoint from the trajectory generator (hold the current position when there is
-///    none);
+///    none; see the hand-overs below);
 /// 3. run the servo control (a DefaultPositionControl unless switched), plus the gravity torque
 ///    when gravity compensation is on (only the gravity torque in zero-gravity mode);
 /// 4. saturate the command (servo control plus gravity) at each joint's torque limit (counted, and
@@ -47,7 +47,20 @@ class SimulatedClock;
 /// loop ends, its last act switches the amplifiers off and writes 0 V to every joint.
 ///
 /// The arm power is on when the loop starts, holding the position the arm is in. In simulation
-/// mode the arm starts at rest at the model's home position.
+/// mode the arm starts at rest at the model's home position (or where rp.cfg's
+/// `simInitialPosition` puts it).
+///
+/// Hand-overs are bumpless: each holds the arm where it is in the cycle the change is taken (the
+/// joints read in that cycle), never at a pose from before. They are: the loop's first cycle (a
+/// program's start, wherever the arm is), the power coming on, a servo control set or released
+/// (the control in use is activated, e.g. a DefaultPositionControl's integral is reset), a
+/// trajectory generator set, replaced, cleared or released (a new generator's first call gets
+/// that hold as the setpoint it starts from), zero-gravity mode switched on (from that cycle only
+/// the gravity torque goes out: neither the servo control nor the generator runs; the arm goes on
+/// under its own momentum) or off (the servo control in use starts afresh, holding there). A
+/// generator still set when zero-gravity mode ends drives the arm again from that cycle, with the
+/// setpoint it gives for that time: clear it first (clearTrajectoryGenerator()) to keep the arm
+/// where it was pushed to.
 ///
 /// Pose, mount and simulation mode: setTransform(), setConnection(), clearConnection(),
 /// setSimulationModeOn() and setSimulationModeOff() rebuild the model (its base is the mount
@@ -246,8 +259,9 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   std::unique_ptr<Differentiator<JointVector>> velocity_;
 
   std::atomic<ServoControl*> servoControl_{nullptr};
-  ServoControl* activeControl_ = nullptr;
+  ServoControl* activeControl_ = nullptr;  // servo thread's: the control last activated (nullptr: activate again)
   std::atomic<TrajectoryGenerator*> generator_{nullptr};
+  const TrajectoryGenerator* activeGenerator_ = nullptr;  // servo thread's: the generator of the last cycle
   std::atomic<const void*> executing_{nullptr};  // the control or generator a cycle is running
   std::atomic<bool> powerRequested_{true};
   std::atomic<bool> gravityCompensation_{true};

@@ -99,6 +99,8 @@ class Manipulator : public PhysicalObject {
   /// @{
 
   /// Connects a trajectory generator; the manipulator follows its setpoints from the next cycle.
+  /// Bumpless: that cycle holds the arm where it is, and the generator's first call gets this
+  /// hold (not an older one) as the setpoint it starts from.
   /// @param[in] generator  the generator (must outlive the connection)
   virtual void setTrajectoryGenerator(TrajectoryGenerator& generator) = 0;
   /// Disconnects the trajectory generator; the manipulator holds its current setpoint.
@@ -116,10 +118,13 @@ class Manipulator : public PhysicalObject {
   virtual void setGravityCompensationOff() = 0;
   /// Whether gravity compensation is on. Real-time safe: yes.
   virtual bool isGravityCompensationOn() const = 0;
-  /// Zero-gravity mode: output only the gravity torque (the servo control is bypassed), so the
-  /// arm floats and can be pushed around (the Teachpendant uses it).
+  /// Zero-gravity mode: output only the gravity torque (the servo control and the trajectory
+  /// generator are bypassed from the next cycle), so the arm floats and can be pushed around (the
+  /// Teachpendant uses it); an arm in motion goes on under its own momentum, without a jump.
   virtual void setZeroGravityModeOn() = 0;
-  /// Leaves zero-gravity mode; the servo control takes over at the current position.
+  /// Leaves zero-gravity mode; the servo control takes over at the current position, starting
+  /// afresh. A trajectory generator still set drives the arm again with its setpoint for that
+  /// time: clear it before to keep the arm where it was pushed to.
   virtual void setZeroGravityModeOff() = 0;
   /// Whether zero-gravity mode is on. Real-time safe: yes.
   virtual bool isZeroGravityModeOn() const = 0;
