@@ -41,7 +41,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const rp::Transform& T = rp::forwardKinematics(*model, scratch, rp::JointVector(n));
     if (!T.allFinite()) std::abort();  // a loaded model is usable
   } catch (const rp::UrdfError& e) {
-    if (std::string(e.what()).rfind(file + ": ", 0) != 0) std::abort();
+    // The message names the file: "FILE: ..." or, for malformed XML, "FILE:LINE:COLUMN: ...".
+    const std::string what = e.what();
+    if (what.rfind(file + ":", 0) != 0) std::abort();
+    const char next = what.size() > file.size() + 1 ? what[file.size() + 1] : '\0';
+    if (next != ' ' && !(next >= '0' && next <= '9')) std::abort();
   }
   return 0;
 }
