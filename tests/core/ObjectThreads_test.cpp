@@ -10,21 +10,13 @@
 #include <string>
 #include <thread>
 
+#include "WaitFor.hpp"
 #include "rp/RoboticPlatform.hpp"
 
 namespace rp {
 namespace {
 
-// Waits up to 10 s for `done`.
-template <typename F>
-bool waitFor(F done) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return true;
-}
+using test::waitFor;
 
 // Asks for one thread that runs until stopped and one periodic thread, and does not start them.
 class Worker : public FunctionalObject {

@@ -12,6 +12,7 @@
 
 #include "AllocationCounter.hpp"
 #include "EffectorTestSupport.hpp"
+#include "WaitFor.hpp"
 #include "NetFtEmulator.hpp"
 #include "rp/effector/AtiFTSensor.hpp"
 #include "rp/math/Transform.hpp"
@@ -63,16 +64,7 @@ TEST_F(ForceTorqueSensorTest, SimulationReportsPayloadWeightAndExternalWrench) {
   EXPECT_EQ(commands[0].name, "Bias");
 }
 
-// Waits up to 10 s for `done`.
-template <typename F>
-bool waitFor(F done) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return true;
-}
+using test::waitFor;
 
 TEST_F(ForceTorqueSensorTest, TheLibraryDrivesUpdate) {
   configure("[ft]\nclass AtiFTSensor\npayload 2\n");  // default updateRate 1000
