@@ -69,6 +69,18 @@ constexpr double kShutdownTimeout = 3.0;  // [s] longest damped hold
 constexpr int kMaxCatchUpSteps = 1000;    // longest stall the simulation integrates, in periods
 constexpr double kSwitchRestVelocity = 0.01;  // [rad/s] at rest enough to leave the hardware
 
+// A setpoint that an arm standing at q can take over without a jump: within these of it.
+constexpr double kHandOverPosition = 0.01;  // [rad or m]
+constexpr double kHandOverVelocity = 0.05;  // [rad/s or m/s]
+
+// The first joint whose setpoint is no hand-over from standing at q, or -1.
+int awayFromTheArm(const JointVector& q, const Setpoint& setpoint) {
+  for (int i = 0; i < q.size(); ++i)
+    if (std::abs(setpoint.position(i) - q(i)) > kHandOverPosition || std::abs(setpoint.velocity(i)) > kHandOverVelocity)
+      return i;
+  return -1;
+}
+
 int firstNonFinite(const JointVector& v) {
   for (int i = 0; i < v.size(); ++i)
     if (!std::isfinite(v(i))) return i;
@@ -311,8 +323,8 @@ void DefaultManipulator::addOperatorCommands() {
   // The pop-up menu's and the control panel's commands (paper Figures 17 and 18): each says what
   // it did, or throws saying why it cannot be done.
   addCommandWithResult("Power On", [this] {
-    // A generator's setpoint moved on while the arm stood braked: powering on would pull the arm
-    // there at once. Its program powers the arm, or the generator is released first.
+    // A generator's setpoint may have moved on while the arm stood braked: the servo loop would
+    // refuse that hand-over with a safe stop (control()); the operator gets a refusal instead.
     if (generator_.load() != nullptr)
       throw std::logic_error("a trajectory generator drives the arm: its program powers it on (or release the generator first)");
     enableArmPower();  // refused during a shutdown, or without hardware and simulation
@@ -691,9 +703,11 @@ void DefaultManipulator::control() {
   int phase = shutdownPhase_.load(std::memory_order_acquire);
   const bool wantPower =
       powerRequested_.load(std::memory_order_relaxed) && phase == 0 && !noHardware_.load(std::memory_order_relaxed);
+  bool poweredOn = false;  // in this cycle: a generator must then start where the arm is (below)
   if (wantPower != power_ && phase == 0) {
     power_ = wantPower;
     sim_->setBrakes(!power_);
+    poweredOn = power_;
     if (power_) activeControl_ = nullptr;  // a hand-over: activate() again below, holding where the arm is
   }
   if (board_) {
@@ -745,10 +759,16 @@ void DefaultManipulator::control() {
     // Re-check: a generator being released is not called any more.
     try {
       if (generator_.load(std::memory_order_seq_cst) == generator && generator->getCurrentSetpoint(t, setpoint_)) {
-        if (setpoint_.position.allFinite() && setpoint_.velocity.allFinite() && setpoint_.acceleration.allFinite()) {
-          hold_ = setpoint_.position;
-        } else {
+        if (!(setpoint_.position.allFinite() && setpoint_.velocity.allFinite() && setpoint_.acceleration.allFinite())) {
           fault("the trajectory generator gave a setpoint that is not a number");
+        } else if (const int j = poweredOn ? awayFromTheArm(q_, setpoint_) : -1; j >= 0) {
+          // The generator was not followed while the arm stood braked, but its motion went on
+          // (or was queued): following it now would pull the arm there at once.
+          fault("power on with the trajectory generator's setpoint %.3g rad, %.3g rad/s away from joint %d: its "
+                "motion went on while the arm was off (release the generator before powering on)",
+                std::abs(setpoint_.position(j) - q_(j)), std::abs(setpoint_.velocity(j)), j + 1);
+        } else {
+          hold_ = setpoint_.position;
         }
       }
     } catch (const std::exception& e) {

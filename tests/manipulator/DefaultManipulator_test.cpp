@@ -341,6 +341,63 @@ TEST_F(ManipulatorTest, PowerOffEngagesTheBrakes) {
   EXPECT_TRUE(puma.isArmPowerOn());
 }
 
+TEST_F(ManipulatorTest, PoweringOnMidMotionStopsSafelyInsteadOfJumpingToTheGeneratorsSetpoint) {
+  // The power goes off 0.4 s into a 1 rad motion of joint 1: the brakes stop the arm there while
+  // the generator's motion goes on in time. A program powering the arm on again must not pull it
+  // to where that motion is by now (the target): the servo loop refuses the hand-over in that
+  // cycle, a visible fault; the arm stays where the brakes stopped it, and the power goes off.
+  Puma560 puma;
+  simClock().pause();
+  DefaultTrajectoryGenerator<6> tragen;
+  puma.setTrajectoryGenerator(tragen);
+  JointVector target = puma.getJointPosition();
+  target(0) += 1.0;
+  tragen.moveRadians(target);
+  ASSERT_TRUE(puma.runCycles(400));
+  puma.disableArmPower();
+  ASSERT_TRUE(puma.runCycles(3000));
+  const JointVector braked = puma.getJointPosition();
+  ASSERT_GT(target(0) - braked(0), 0.3) << "the brakes stopped the arm short of the target [rad]";
+  puma.enableArmPower();
+  (void)puma.runCycles(1000);  // false once the loop has ended
+  EXPECT_TRUE(ObjectManager::isShutdownRequested());
+  EXPECT_NE(puma.getErrorStatus().message.find("power on with the trajectory generator's setpoint"),
+            std::string::npos)
+      << puma.getErrorStatus().message;
+  EXPECT_NE(puma.getErrorStatus().message.find("from joint 1"), std::string::npos) << puma.getErrorStatus().message;
+  EXPECT_LT((puma.getJointPosition() - braked).cwiseAbs().maxCoeff(), 0.01) << "the arm did not jump";
+  EXPECT_FALSE(puma.isArmPowerOn()) << "the safe stop ends with the power off";
+  simClock().resume();
+  puma.clearTrajectoryGenerator();
+}
+
+TEST_F(ManipulatorTest, PoweringOnAtTheGeneratorsLastTargetFollowsItAgain) {
+  // The same off and on at rest after the motion ended: the generator holds the target, where the
+  // arm is, so the power comes on without a fault and the next motion runs.
+  Puma560 puma;
+  simClock().pause();
+  DefaultTrajectoryGenerator<6> tragen;
+  puma.setTrajectoryGenerator(tragen);
+  JointVector target = puma.getJointPosition();
+  target(0) += 0.5;
+  tragen.moveRadians(target);
+  ASSERT_TRUE(puma.runCycles(4000));
+  ASSERT_TRUE(tragen.isDone());
+  puma.disableArmPower();
+  ASSERT_TRUE(puma.runCycles(500));
+  puma.enableArmPower();
+  ASSERT_TRUE(puma.runCycles(100));
+  EXPECT_TRUE(puma.isArmPowerOn());
+  target(1) += 0.3;
+  tragen.moveRadians(target);
+  ASSERT_TRUE(puma.runCycles(4000));
+  EXPECT_LT((puma.getJointPosition() - target).cwiseAbs().maxCoeff(), 1e-2) << "the next motion ran";
+  simClock().resume();
+  EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
+  EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+  puma.clearTrajectoryGenerator();
+}
+
 // A servo control that outputs nothing: gravity compensation alone holds the arm, so a push moves
 // it away from where the last hand-over held it.
 struct DoNothing : ServoControl {
