@@ -172,6 +172,15 @@ void RoboticObject::addCommandWithResult(const std::string& name, std::function<
   impl_->commands.push_back({name, description, std::move(action)});
 }
 
+bool RoboticObject::removeCommand(const std::string& name) {
+  std::lock_guard<std::mutex> lock(impl_->commandMutex);
+  auto& commands = impl_->commands;
+  const auto it = std::find_if(commands.begin(), commands.end(), [&](const auto& c) { return c.name == name; });
+  if (it == commands.end()) return false;
+  commands.erase(it);
+  return true;
+}
+
 std::vector<CommandInfo> RoboticObject::getCommands() const {
   std::lock_guard<std::mutex> lock(impl_->commandMutex);
   std::vector<CommandInfo> out;

@@ -12,6 +12,7 @@
 #include "rp/effector/Gripper.hpp"
 #include "rp/gui/SceneViewer.hpp"
 #include "rp/gui/UrdfVisuals.hpp"
+#include "rp/manipulator/DefaultManipulator.hpp"
 #include "rp/manipulator/Manipulator.hpp"
 #include "rp/manipulator/UrdfManipulator.hpp"
 #include "rp/model/Kinematics.hpp"
@@ -274,6 +275,11 @@ json SceneState::describe(Entry& e) {
     j["vmax"] = vectorJson(model.getVelocityLimit());
     j["home"] = vectorJson(model.getHomePosition());
     j["servoRate"] = 1.0 / e.manipulator->getServoPeriod();
+    if (const auto* arm = dynamic_cast<const DefaultManipulator*>(e.manipulator)) {
+      // The panel's servo-control switch: the controls offered, the one in use.
+      j["servoControls"] = arm->getServoControlNames();
+      j["servoControl"] = arm->getServoControlName();
+    }
   }
   return j;
 }

@@ -68,6 +68,7 @@ constexpr double kRestDuration = 0.05;  // [s] at rest before the power goes off
 constexpr double kShutdownTimeout = 3.0;  // [s] longest damped hold
 constexpr int kMaxCatchUpSteps = 1000;    // longest stall the simulation integrates, in periods
 constexpr double kSwitchRestVelocity = 0.01;  // [rad/s] at rest enough to leave the hardware
+const std::string kServoControlCommand = "Servo Control: ";  // + the control's name
 
 // A setpoint that an arm standing at q can take over without a jump: within these of it.
 constexpr double kHandOverPosition = 0.01;  // [rad or m]
@@ -321,7 +322,9 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
 
 void DefaultManipulator::addOperatorCommands() {
   // The pop-up menu's and the control panel's commands (paper Figures 17 and 18): each says what
-  // it did, or throws saying why it cannot be done.
+  // it did, or throws saying why it cannot be done. The servo controls offered come last (the
+  // DefaultPositionControl first, then those set or added).
+
   addCommandWithResult("Power On", [this] {
     // A generator's setpoint may have moved on while the arm stood braked: the servo loop would
     // refuse that hand-over with a safe stop (control()); the operator gets a refusal instead.
@@ -358,6 +361,8 @@ void DefaultManipulator::addOperatorCommands() {
     holdHere_.store(true);
     return std::string("holding the arm where it is");
   }, "hold the arm at its present position");
+  std::lock_guard<std::mutex> lock(offersMutex_);
+  offerLocked(*defaultControl_);
 }
 
 DefaultManipulator::~DefaultManipulator() {
@@ -483,8 +488,17 @@ void DefaultManipulator::releaseTrajectoryGenerator(TrajectoryGenerator& generat
 }
 
 void DefaultManipulator::releaseServoControl(ServoControl& control) {
-  ServoControl* expected = &control;
-  servoControl_.compare_exchange_strong(expected, defaultControl_.get());
+  {
+    std::lock_guard<std::mutex> lock(offersMutex_);
+    ServoControl* expected = &control;
+    servoControl_.compare_exchange_strong(expected, defaultControl_.get());
+    if (&control != defaultControl_.get()) {
+      if (const auto it = std::find(offers_.begin(), offers_.end(), &control); it != offers_.end()) {
+        offers_.erase(it);
+        removeCommand(kServoControlCommand + control.getName());
+      }
+    }
+  }
   waitUntilNotExecuting(&control);
 }
 
@@ -496,11 +510,46 @@ void DefaultManipulator::waitUntilNotExecuting(const void* object) const {
 TrajectoryGenerator* DefaultManipulator::getTrajectoryGenerator() const { return generator_.load(); }
 
 void DefaultManipulator::setServoControl(ServoControl& control) {
+  std::lock_guard<std::mutex> lock(offersMutex_);
   if (control.getManipulator() != this) control.attach(*this);
+  offerLocked(control);
   servoControl_.store(&control);
 }
 
 ServoControl& DefaultManipulator::getServoControl() const { return *servoControl_.load(); }
+
+void DefaultManipulator::addServoControl(ServoControl& control) {
+  std::lock_guard<std::mutex> lock(offersMutex_);
+  if (control.getManipulator() != this) control.attach(*this);
+  offerLocked(control);
+}
+
+void DefaultManipulator::offerLocked(ServoControl& control) {
+  if (std::find(offers_.begin(), offers_.end(), &control) != offers_.end()) return;
+  const std::string name = control.getName();  // unique among live objects, so among the offers
+  addCommandWithResult(kServoControlCommand + name, [this, name] {
+    // By name, under the lock: a control released (destroyed) meanwhile is not found.
+    std::lock_guard<std::mutex> lock(offersMutex_);
+    const auto it = std::find_if(offers_.begin(), offers_.end(), [&](const ServoControl* c) { return c->getName() == name; });
+    if (it == offers_.end()) throw std::invalid_argument("the servo control '" + name + "' is no longer offered");
+    if (shutdownPhase_.load() != 0) throw std::logic_error("not during a shutdown");
+    servoControl_.store(*it);
+    return "servo control " + name + " in use: it starts holding the arm where it is";
+  }, "use the servo control " + name + " (it takes over holding the arm where it is)");
+  offers_.push_back(&control);
+}
+
+std::vector<std::string> DefaultManipulator::getServoControlNames() const {
+  std::lock_guard<std::mutex> lock(offersMutex_);
+  std::vector<std::string> names;
+  for (const ServoControl* c : offers_) names.push_back(c->getName());
+  return names;
+}
+
+std::string DefaultManipulator::getServoControlName() const {
+  std::lock_guard<std::mutex> lock(offersMutex_);
+  return servoControl_.load()->getName();
+}
 
 void DefaultManipulator::setZeroGravityModeOff() {
   holdHere_.store(true);  // the servo control takes over where the arm was pushed to

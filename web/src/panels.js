@@ -76,6 +76,9 @@ export class PopupMenu {
   }
 }
 
+// The prefix of a manipulator's commands that switch its servo control (DefaultManipulator).
+const SERVO_CONTROL_COMMAND = 'Servo Control: ';
+
 // A control panel window for one object.
 export class ControlPanel {
   constructor(conn, name, notify, onClose) {
@@ -211,22 +214,41 @@ export class ControlPanel {
     this.body.replaceChildren(...rows);
   }
   // The command buttons, rebuilt when the object's commands change.
+  // A manipulator's servo controls (commands "Servo Control: NAME") are one switch, showing the
+  // one in use, instead of a button each.
   setCommands(desc) {
-    const key = JSON.stringify(desc.commands || []);
-    if (key === this.commandKey) return;
-    this.commandKey = key;
-    const buttons = (desc.commands || []).map((c) => el('button', { 'data-command': c.name, title: c.description || c.name,
-      onclick: () => this.run(c.name) }, c.name));
-    this.commands.replaceChildren(...buttons);
-    this.commands.classList.toggle('hidden', buttons.length === 0);
+    const servo = SERVO_CONTROL_COMMAND;
+    const key = JSON.stringify([desc.commands || [], desc.servoControls || []]);
+    if (key !== this.commandKey) {
+      this.commandKey = key;
+      const items = (desc.commands || []).filter((c) => !c.name.startsWith(servo)).map((c) =>
+        el('button', { 'data-command': c.name, title: c.description || c.name, onclick: () => this.run(c.name) }, c.name));
+      this.servoSwitch = null;
+      if ((desc.servoControls || []).length) {
+        this.servoSwitch = el('select', { 'data-field': 'servoControl', title: 'the servo control in use',
+          onchange: () => this.run(servo + this.servoSwitch.value).then((ok) => {
+            if (!ok && this.desc.servoControl) this.servoSwitch.value = this.desc.servoControl;  // refused
+          }) },
+        ...desc.servoControls.map((n) => el('option', { value: n }, n)));
+        items.push(el('label', { class: 'servo-switch' }, 'Servo control ', this.servoSwitch));
+      }
+      this.commands.replaceChildren(...items);
+      this.commands.classList.toggle('hidden', items.length === 0);
+    }
+    // The one in use, as the program says (a refused switch goes back to it).
+    if (this.servoSwitch && desc.servoControl && document.activeElement !== this.servoSwitch)
+      this.servoSwitch.value = desc.servoControl;
   }
   // Runs command `name`; shows what it did, or why it was refused.
+  // Resolves to whether it was carried out.
   run(name) {
     return this.conn.command(this.name, name).then((r) => {
       this.showResult(`${name}: ${(r && r.reply) || 'done'}`, false);
+      return true;
     }, (e) => {
       this.showResult(`${name}: ${e.message}`, true);
       this.notify(`${this.name}: ${name}: ${e.message}`);
+      return false;
     });
   }
   showResult(text, refused) {

@@ -174,6 +174,12 @@ class RoboticObject {
   /// Real-time safe: no.
   void addCommandWithResult(const std::string& name, std::function<std::string()> action,
                             const std::string& description = "");
+  /// Withdraws the command `name` (a command offered only while something exists, such as a
+  /// manipulator's "Servo Control: NAME"). A run of it already started goes on.
+  /// @param[in] name  command name
+  /// @return whether there was such a command
+  /// Real-time safe: no.
+  bool removeCommand(const std::string& name);
   /// The registered commands in registration order. Real-time safe: no.
   std::vector<CommandInfo> getCommands() const;
   /// Runs the command `name`.

@@ -139,8 +139,22 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void setTrajectoryGenerator(TrajectoryGenerator& generator) override;
   void clearTrajectoryGenerator() override;
   TrajectoryGenerator* getTrajectoryGenerator() const override;
+  /// Uses `control` from the next cycle (a bumpless hand-over) and offers it to the operator (see
+  /// addServoControl()).
   void setServoControl(ServoControl& control) override;
   ServoControl& getServoControl() const override;
+  /// Offers `control` to the operator without using it: the control panel's servo-control switch
+  /// and the pop-up menu list it (command "Servo Control: NAME", which calls setServoControl()),
+  /// next to the DefaultPositionControl and every control set with setServoControl(). The offer
+  /// ends when the control is released or destroyed (releaseServoControl()).
+  /// @param[in] control  a servo control for this manipulator (attached now)
+  /// Real-time safe: no.
+  void addServoControl(ServoControl& control);
+  /// The names of the offered servo controls, in the order they were offered (the
+  /// DefaultPositionControl first). Real-time safe: no.
+  std::vector<std::string> getServoControlNames() const;
+  /// The name of the servo control in use. Real-time safe: no.
+  std::string getServoControlName() const;
   /// The DefaultPositionControl the manipulator created.
   DefaultPositionControl& getDefaultPositionControl() { return *defaultControl_; }
   void setGravityCompensationOn() override { gravityCompensation_.store(true); }
@@ -219,6 +233,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void applySetup(Setup& setup) noexcept;  // in the servo thread between cycles: install and carry the state over
   void applyWrenches(int n);               // the last external wrenches to the simulation
   void addOperatorCommands();              // Power On/Off, Gravity Compensation, Zero Gravity, Hold Here
+  void offerLocked(ServoControl& control);  // with offersMutex_ held: offers_ and its command
 
   bool inServoThread() const;
   void waitUntilNotExecuting(const void* object) const;
@@ -252,6 +267,9 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   std::atomic<bool> usesHardware_{false};
   std::unique_ptr<ManipulatorData> data_;  // servo thread's
   std::unique_ptr<ManipulatorSimulation> sim_;
+  // (Before defaultControl_: its destructor releases it, which takes them.)
+  mutable std::mutex offersMutex_;     // offers_; held while an offered control is set or released
+  std::vector<ServoControl*> offers_;  // the servo controls the operator can switch to
   std::unique_ptr<DefaultPositionControl> defaultControl_;
   std::unique_ptr<WrenchBox> wrench_;
   std::unique_ptr<IoBoard> board_;  // hardware server client, when simulation mode is off
