@@ -341,20 +341,27 @@ TEST_F(ManipulatorTest, PowerOffEngagesTheBrakes) {
   EXPECT_TRUE(puma.isArmPowerOn());
 }
 
+// On the paused simulated clock: `tragen` drives `puma` to joint 1 + `radians`; the power goes
+// off after `cycles` cycles. Returns the target.
+JointVector moveJointOneThenPowerOff(Puma560& puma, DefaultTrajectoryGenerator<6>& tragen, double radians, int cycles) {
+  simClock().pause();
+  puma.setTrajectoryGenerator(tragen);
+  JointVector target = puma.getJointPosition();
+  target(0) += radians;
+  tragen.moveRadians(target);
+  EXPECT_TRUE(puma.runCycles(static_cast<std::uint64_t>(cycles)));
+  puma.disableArmPower();
+  return target;
+}
+
 TEST_F(ManipulatorTest, PoweringOnMidMotionStopsSafelyInsteadOfJumpingToTheGeneratorsSetpoint) {
   // The power goes off 0.4 s into a 1 rad motion of joint 1: the brakes stop the arm there while
   // the generator's motion goes on in time. A program powering the arm on again must not pull it
   // to where that motion is by now (the target): the servo loop refuses the hand-over in that
   // cycle, a visible fault; the arm stays where the brakes stopped it, and the power goes off.
   Puma560 puma;
-  simClock().pause();
   DefaultTrajectoryGenerator<6> tragen;
-  puma.setTrajectoryGenerator(tragen);
-  JointVector target = puma.getJointPosition();
-  target(0) += 1.0;
-  tragen.moveRadians(target);
-  ASSERT_TRUE(puma.runCycles(400));
-  puma.disableArmPower();
+  const JointVector target = moveJointOneThenPowerOff(puma, tragen, 1.0, 400);
   ASSERT_TRUE(puma.runCycles(3000));
   const JointVector braked = puma.getJointPosition();
   ASSERT_GT(target(0) - braked(0), 0.3) << "the brakes stopped the arm short of the target [rad]";
@@ -375,15 +382,9 @@ TEST_F(ManipulatorTest, PoweringOnAtTheGeneratorsLastTargetFollowsItAgain) {
   // The same off and on at rest after the motion ended: the generator holds the target, where the
   // arm is, so the power comes on without a fault and the next motion runs.
   Puma560 puma;
-  simClock().pause();
   DefaultTrajectoryGenerator<6> tragen;
-  puma.setTrajectoryGenerator(tragen);
-  JointVector target = puma.getJointPosition();
-  target(0) += 0.5;
-  tragen.moveRadians(target);
-  ASSERT_TRUE(puma.runCycles(4000));
+  JointVector target = moveJointOneThenPowerOff(puma, tragen, 0.5, 4000);
   ASSERT_TRUE(tragen.isDone());
-  puma.disableArmPower();
   ASSERT_TRUE(puma.runCycles(500));
   puma.enableArmPower();
   ASSERT_TRUE(puma.runCycles(100));
