@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "../common/ToolSupport.hpp"
 #include "rp/model/Model.hpp"
 
 namespace {
@@ -32,25 +33,9 @@ namespace {
 using namespace rp;
 using nlohmann::json;
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using tool::UsageError;
+using tool::numbers;
 
-std::vector<double> numbers(const std::string& option, const std::string& text) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    char* end = nullptr;
-    const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0') {
-      throw UsageError(option + ": '" + item + "' is not a number");
-    }
-    if (!std::isfinite(x)) throw UsageError(option + ": '" + item + "' is not a finite number");
-    v.push_back(x);
-  }
-  return v;
-}
 
 // One value per joint: "v1,v2,..." in joint order, or "name=value,..." naming every joint once.
 // --offchain "name=value,...": positions of moving joints off the chain [rad or m], each joint once.
@@ -120,22 +105,8 @@ JointVector jointsOf(const ManipulatorModel& model, const std::map<std::string, 
   return q;
 }
 
-template <typename M>
-json matrix(const M& m) {
-  json rows = json::array();
-  for (Eigen::Index r = 0; r < m.rows(); ++r) {
-    json row = json::array();
-    for (Eigen::Index c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-json vector(const JointVector& v) {
-  json a = json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
-  return a;
-}
+json matrix(const auto& m) { return tool::matrixJson(m); }
+json vector(const JointVector& v) { return tool::vectorJson(v); }
 
 int run(int argc, char** argv) {
   std::map<std::string, std::string> opts;
@@ -284,6 +255,7 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
+// (Not tool::runTool(): GCC 12 then sees a bogus overflow in the Eigen copy of jointsOf().)
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);

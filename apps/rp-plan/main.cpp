@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "../common/ToolSupport.hpp"
 #include "rp/model/ManipulatorModel.hpp"
 #include "rp/trajectory/SynchronizedJointMotion.hpp"
 
@@ -29,28 +30,17 @@ namespace {
 using namespace rp;
 using nlohmann::json;
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using tool::UsageError;
 
-constexpr double kMaxSamples = 1e7;
-
+// A comma-separated list of finite numbers, not empty and without a trailing comma.
 std::vector<double> numbers(const std::string& option, const std::string& text) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    char* end = nullptr;
-    const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0') {
-      throw UsageError(option + ": '" + item + "' is not a number");
-    }
-    if (!std::isfinite(x)) throw UsageError(option + ": '" + item + "' is not a finite number");
-    v.push_back(x);
-  }
+  std::vector<double> v = tool::numbers(option, text);
   if (v.empty() || (!text.empty() && text.back() == ',')) throw UsageError(option + ": '" + text + "' is not a list of numbers");
   return v;
 }
+
+constexpr double kMaxSamples = 1e7;
+
 
 JointVector joints(const std::map<std::string, std::string>& opts, const std::string& option, int n, bool limit) {
   const auto it = opts.find(option);
@@ -70,11 +60,7 @@ JointVector joints(const std::map<std::string, std::string>& opts, const std::st
   return q;
 }
 
-json row(const JointVector& v) {
-  json a = json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
-  return a;
-}
+json row(const JointVector& v) { return tool::vectorJson(v); }
 
 int run(int argc, char** argv) {
   std::map<std::string, std::string> opts;
@@ -153,11 +139,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "rp-plan: " << e.what() << std::endl;
-    return 2;
-  }
-}
+int main(int argc, char** argv) { return rp::tool::runTool("rp-plan", run, argc, argv); }

@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "../../apps/common/ToolSupport.hpp"
 #include "rp/model/Model.hpp"
 
 namespace {
@@ -24,22 +25,8 @@ namespace {
 using namespace rp;
 using nlohmann::json;
 
-template <typename M>
-json matrix(const M& m) {
-  json rows = json::array();
-  for (Eigen::Index r = 0; r < m.rows(); ++r) {
-    json row = json::array();
-    for (Eigen::Index c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-json vector(const JointVector& v) {
-  json a = json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
-  return a;
-}
+json matrix(const auto& m) { return tool::matrixJson(m); }
+json vector(const JointVector& v) { return tool::vectorJson(v); }
 
 JointVector joints(const json& j, int n, const char* what) {
   if (!j.is_array() || static_cast<int>(j.size()) != n)
@@ -135,11 +122,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "rp-python-reference: " << e.what() << std::endl;
-    return 2;
-  }
-}
+int main(int argc, char** argv) { return rp::tool::runTool("rp-python-reference", run, argc, argv); }
