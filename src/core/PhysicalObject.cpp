@@ -1,17 +1,53 @@
 // PhysicalObject: pose, connection, simulation and display modes, default 3D model.
 #include "rp/core/PhysicalObject.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <vector>
 #include <stdexcept>
 
+#include "PhysicalObjectViews.hpp"
 #include "rp/core/RoboticPlatform.hpp"
 
 namespace rp {
 
 namespace {
 constexpr int kMaxMountDepth = 64;  // longest chain of connections followed
+
+// The PhysicalObjects whose PhysicalObject part is complete (internal::unpublishedPhysicalObjects()).
+struct Constructed {
+  std::mutex mutex;
+  std::vector<const PhysicalObject*> objects;
+};
+Constructed& constructed() {
+  static auto* c = new Constructed;  // never destroyed: objects may outlive static destruction
+  return *c;
+}
 }  // namespace
+
+namespace internal {
+std::vector<PhysicalObjectView> unpublishedPhysicalObjects() {
+  Constructed& c = constructed();
+  std::lock_guard<std::mutex> lock(c.mutex);
+  std::vector<PhysicalObjectView> views;
+  for (const PhysicalObject* o : c.objects) {
+    if (o->isObjectPublished()) continue;
+    PhysicalObjectView v;
+    v.name = o->getName();
+    v.transform = o->getTransform();
+    v.mount = o->getConnection();
+    v.mountFrame = o->getConnectionFrame();
+    v.display = o->getDisplayMode();
+    v.model = o->PhysicalObject::get3DModel();
+    // A mount in this list is alive while the lock is held (others are looked up by the caller).
+    if (v.mount != nullptr && std::find(c.objects.begin(), c.objects.end(), v.mount) != c.objects.end())
+      v.mountName = v.mount->getName();
+    views.push_back(std::move(v));
+  }
+  return views;
+}
+}  // namespace internal
 
 struct PhysicalObject::Impl {
   mutable std::mutex mutex;
@@ -34,31 +70,44 @@ void PhysicalObject::changed(const Undo& undo) {
 }
 
 PhysicalObject::PhysicalObject(const std::string& name) : RoboticObject(name), pimpl_(std::make_unique<Impl>()) {
-  const ConfigSection* section = configSection();
-  if (!section) return;
-  // rp.cfg units: position in millimetres, orientation (roll, pitch, yaw) in degrees.
-  Vector<3> p;
-  Vector<3> rpy;
-  if (section->has("position")) {
-    auto v = section->getNumbers("position");
-    if (v.size() != 3) throw section->errorAt(*section->find("position"), "setting 'position' needs 3 values");
-    p = v[0] / 1000.0, v[1] / 1000.0, v[2] / 1000.0;
-  }
-  if (section->has("orientation")) {
-    auto v = section->getNumbers("orientation");
-    if (v.size() != 3) throw section->errorAt(*section->find("orientation"), "setting 'orientation' needs 3 values");
-    rpy = v[0] * M_PI / 180.0, v[1] * M_PI / 180.0, v[2] * M_PI / 180.0;
-  }
-  pimpl_->transform = translation(p) * rpyToTransform(rpy(0), rpy(1), rpy(2));
-  if (section->has("simulationMode")) pimpl_->simulation = section->getWord("simulationMode") == "on" ? 1 : 0;
-  if (section->has("display")) {
-    std::string d = section->getWord("display");
-    pimpl_->display = static_cast<int>(d == "off" ? DisplayMode::Off : d == "wireframe" ? DisplayMode::Wireframe
-                                                                                          : DisplayMode::Solid);
-  }
+  [&] {  // rp.cfg's settings
+    const ConfigSection* section = configSection();
+    if (!section) return;
+    // rp.cfg units: position in millimetres, orientation (roll, pitch, yaw) in degrees.
+    Vector<3> p;
+    Vector<3> rpy;
+    if (section->has("position")) {
+      auto v = section->getNumbers("position");
+      if (v.size() != 3) throw section->errorAt(*section->find("position"), "setting 'position' needs 3 values");
+      p = v[0] / 1000.0, v[1] / 1000.0, v[2] / 1000.0;
+    }
+    if (section->has("orientation")) {
+      auto v = section->getNumbers("orientation");
+      if (v.size() != 3) throw section->errorAt(*section->find("orientation"), "setting 'orientation' needs 3 values");
+      rpy = v[0] * M_PI / 180.0, v[1] * M_PI / 180.0, v[2] * M_PI / 180.0;
+    }
+    pimpl_->transform = translation(p) * rpyToTransform(rpy(0), rpy(1), rpy(2));
+    if (section->has("simulationMode")) pimpl_->simulation = section->getWord("simulationMode") == "on" ? 1 : 0;
+    if (section->has("display")) {
+      std::string d = section->getWord("display");
+      pimpl_->display = static_cast<int>(d == "off" ? DisplayMode::Off : d == "wireframe" ? DisplayMode::Wireframe
+                                                                                            : DisplayMode::Solid);
+    }
+  }();
+  // Complete as a PhysicalObject: the Scene Viewer may draw it from here, published or not.
+  Constructed& c = constructed();
+  std::lock_guard<std::mutex> lock(c.mutex);
+  c.objects.push_back(this);
 }
 
-PhysicalObject::~PhysicalObject() { withdrawObject(); }  // first thing for a plain PhysicalObject
+PhysicalObject::~PhysicalObject() {
+  {
+    Constructed& c = constructed();
+    std::lock_guard<std::mutex> lock(c.mutex);
+    c.objects.erase(std::remove(c.objects.begin(), c.objects.end(), this), c.objects.end());
+  }
+  withdrawObject();  // first thing for a plain PhysicalObject
+}
 
 void PhysicalObject::declareSettings(SettingSchema& schema) {
   RoboticObject::declareSettings(schema);

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <set>
 
+#include "../core/PhysicalObjectViews.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/effector/Gripper.hpp"
 #include "rp/gui/SceneViewer.hpp"
@@ -40,6 +41,15 @@ const char* shapeKindName(ShapeKind k) {
     case ShapeKind::Mesh: return "mesh";
   }
   return "box";
+}
+
+json shapeJson(const Shape& s) {
+  return json{{"kind", shapeKindName(s.kind)},
+              {"frame", s.frame},
+              {"pose", transformJson(s.pose)},
+              {"size", {s.size(0), s.size(1), s.size(2)}},
+              {"mesh", s.meshFile},
+              {"color", {s.color.r, s.color.g, s.color.b, s.color.a}}};
 }
 
 const char* displayName(DisplayMode m) {
@@ -205,14 +215,6 @@ json SceneState::describe(Entry& e) {
     e.frames = m.frames;
     json shapes = json::array();
     e.meshes.clear();
-    auto shapeJson = [](const Shape& s) {
-      return json{{"kind", shapeKindName(s.kind)},
-                  {"frame", s.frame},
-                  {"pose", transformJson(s.pose)},
-                  {"size", {s.size(0), s.size(1), s.size(2)}},
-                  {"mesh", s.meshFile},
-                  {"color", {s.color.r, s.color.g, s.color.b, s.color.a}}};
-    };
     for (const Shape& s : m.shapes) {
       e.meshes.push_back(s.kind == ShapeKind::Mesh ? s.meshFile : std::string());
       shapes.push_back(shapeJson(s));
@@ -293,6 +295,9 @@ bool SceneState::refresh() {
   std::vector<ObjectReference> published = om.getPublishedObjects();
   std::map<std::string, RoboticObject*> byName;  // published objects
   for (const ObjectReference& r : published) byName[r->getName()] = r.get();
+  std::map<std::string, PhysicalObjectView> unpublished;  // physical objects that do not publish themselves
+  for (PhysicalObjectView& v : unpublishedPhysicalObjects()) unpublished.emplace(v.name, std::move(v));
+  unpublishedIndex_.clear();
   json objects = json::array();
   std::set<RoboticObject*> present;
   for (auto& [object, e] : entries_) e.index = -1;  // set again below for the objects listed now
@@ -323,6 +328,11 @@ bool SceneState::refresh() {
     if (last) {
       objects.push_back(last->description);  // withdrawn: as last described, without state
       present.insert(last->object);
+    } else if (const auto v = unpublished.find(name); v != unpublished.end()) {
+      // A physical object of a class that does not publish itself: drawn from its
+      // PhysicalObject part (PhysicalObject's own look, its pose and mount), no panel.
+      objects.push_back(describeUnpublished(v->second, byName));
+      unpublishedIndex_[name] = static_cast<int>(objects.size()) - 1;
     } else {
       objects.push_back({{"path", "/objects/" + name},
                          {"name", name},
@@ -404,37 +414,8 @@ std::string SceneState::buildFrame() {
         }
       }
     } else if (e.physical) {
-      // World pose through the chain of connections (bounded: a cycle cannot hang us).
-      Transform world = e.physical->getTransform();
-      PhysicalObject* child = e.physical;
-      for (int depth = 0; depth < 16; ++depth) {
-        PhysicalObject* mount = child->getConnection();
-        if (!mount || !live.count(mount)) break;  // a mount not published is not read
-        Transform frame = mount->getTransform();
-        if (auto* m = dynamic_cast<Manipulator*>(mount)) {
-          const std::string f = child->getConnectionFrame();
-          frame = m->getModel().getBaseTransform();
-          if (f != "base") {
-            auto mi = entries_.find(mount);
-            if (mi != entries_.end() && mi->second.data) {
-              const ManipulatorModel& model = m->getModel();
-              JointVector q = m->getJointPosition();
-              if (q.size() == model.getNumberOfJoints()) {
-                forwardKinematics(model, *mi->second.data, q);
-                if (f == "endEffector") frame = mi->second.data->endEffector;
-                else if (f.rfind("link", 0) == 0) {
-                  int k = std::atoi(f.c_str() + 4);
-                  if (k >= 1 && k <= model.getNumberOfJoints()) frame = mi->second.data->linkTransforms[static_cast<std::size_t>(k - 1)];
-                }
-              }
-            }
-          }
-          world = frame * world;
-          break;  // a manipulator's frames are already in the world
-        }
-        world = frame * world;
-        child = mount;
-      }
+      const Transform world = mountedPose(e.physical->getTransform(), e.physical->getConnection(),
+                                          e.physical->getConnectionFrame(), live);
       for (auto& p : poses) p = world;
     }
     put32(out, static_cast<std::uint32_t>(e.index));
@@ -446,11 +427,77 @@ std::string SceneState::buildFrame() {
     for (int i = 0; i < values; ++i) putDouble(out, snap.values[i]);
     ++count;
   }
+  // Physical objects of classes that do not publish themselves: their base frame.
+  for (const PhysicalObjectView& v : unpublishedPhysicalObjects()) {
+    const auto it = unpublishedIndex_.find(v.name);
+    if (it == unpublishedIndex_.end()) continue;  // not in the scene yet
+    put32(out, static_cast<std::uint32_t>(it->second));
+    put32(out, 1);  // one frame
+    put32(out, 0);  // no state values
+    put32(out, 0);  // no error
+    putTransform(out, mountedPose(v.transform, const_cast<PhysicalObject*>(v.mount), v.mountFrame, live));
+    ++count;
+  }
   for (int i = 0; i < 4; ++i) out[countAt + static_cast<std::size_t>(i)] = static_cast<char>((count >> (8 * i)) & 0xffu);
   std::string t;
   putDouble(t, time);
   out.replace(timeAt, 8, t);
   return out;
+}
+
+Transform SceneState::mountedPose(Transform world, PhysicalObject* mount, std::string frame,
+                                  const std::set<const RoboticObject*>& live) {
+  // World pose through the chain of connections (bounded: a cycle cannot hang us).
+  for (int depth = 0; depth < 16; ++depth) {
+    if (!mount || !live.count(mount)) break;  // a mount not published is not read
+    auto* m = dynamic_cast<Manipulator*>(mount);
+    if (m == nullptr) {
+      world = mount->getTransform() * world;
+      frame = mount->getConnectionFrame();
+      mount = mount->getConnection();
+      continue;
+    }
+    // A manipulator's frames are in the world already.
+    Transform at = m->getModel().getBaseTransform();
+    auto mi = entries_.find(mount);
+    if (frame != "base" && mi != entries_.end() && mi->second.data) {
+      const ManipulatorModel& model = m->getModel();
+      JointVector q = m->getJointPosition();
+      if (q.size() == model.getNumberOfJoints()) {
+        forwardKinematics(model, *mi->second.data, q);
+        if (frame == "endEffector") {
+          at = mi->second.data->endEffector;
+        } else if (frame.rfind("link", 0) == 0) {
+          const int k = std::atoi(frame.c_str() + 4);
+          if (k >= 1 && k <= model.getNumberOfJoints()) at = mi->second.data->linkTransforms[static_cast<std::size_t>(k - 1)];
+        }
+      }
+    }
+    return at * world;
+  }
+  return world;
+}
+
+json SceneState::describeUnpublished(const PhysicalObjectView& v, const std::map<std::string, RoboticObject*>& published) {
+  json shapes = json::array();
+  for (const Shape& s : v.model.shapes) shapes.push_back(shapeJson(s));
+  std::string mount = v.mountName;
+  for (const auto& [name, object] : published)
+    if (v.mount != nullptr && object == static_cast<const RoboticObject*>(v.mount)) mount = name;
+  return {{"path", "/objects/" + v.name},
+          {"name", v.name},
+          {"className", ""},
+          {"kind", "physical"},
+          {"published", false},
+          {"physical", true},
+          {"hasControlLoop", false},
+          {"error", {{"code", 0}, {"message", ""}}},
+          {"commands", json::array()},
+          {"panel", {{"title", v.name}, {"fields", json::array()}}},
+          {"frames", json::array({"base"})},
+          {"shapes", shapes},
+          {"display", displayName(v.display)},
+          {"connection", mount.empty() ? json(nullptr) : json{{"object", mount}, {"frame", v.mountFrame}}}};
 }
 
 }  // namespace rp::internal

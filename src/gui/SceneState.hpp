@@ -22,6 +22,7 @@ struct ManipulatorData;
 }  // namespace rp
 
 namespace rp::internal {
+struct PhysicalObjectView;
 
 // Magic number at the start of every binary state frame: "RPS1" read as a little-endian u32.
 inline constexpr std::uint32_t kStateFrameMagic = 0x31535052u;
@@ -72,11 +73,17 @@ class SceneState {
     std::string urdfError;            // why they could not be read
   };
   nlohmann::json describe(Entry& e);
+  // A physical object of a class that does not publish itself (see unpublishedPhysicalObjects()).
+  nlohmann::json describeUnpublished(const PhysicalObjectView& v, const std::map<std::string, RoboticObject*>& published);
+  // The world pose of `world` given relative to frame `frame` of `mount`, through the chain of
+  // mounts as far as they are published (in `live`; others are not read).
+  Transform mountedPose(Transform world, PhysicalObject* mount, std::string frame, const std::set<const RoboticObject*>& live);
   void loadVisuals(Entry& e);
   // Prints `what` about mesh `file` on stderr unless it was printed for that file already.
   bool reportOnce(const std::string& file, const std::string& what);
 
   std::map<RoboticObject*, Entry> entries_;
+  std::map<std::string, int> unpublishedIndex_;  // scene index of each unpublished physical object drawn
   std::string sceneMessage_;
   std::string lastObjects_;
   std::uint32_t version_ = 0;

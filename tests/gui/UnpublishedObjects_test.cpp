@@ -1,0 +1,160 @@
+// Physical objects of classes that do not publish themselves (a user's PhysicalObject subclass
+// without publishObject(), or a plain PhysicalObject) are drawn anyway: the Scene Viewer's scene
+// lists them with PhysicalObject's own look, where rp.cfg or setTransform() puts them and on
+// their mount, read only from their PhysicalObject part, from the end of PhysicalObject's
+// constructor to the start of its destructor. Labelled "threads": ThreadSanitizer checks that a
+// reader never touches the rest of an object being constructed or destroyed.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "SceneState.hpp"
+#include "rp/RoboticPlatform.hpp"
+
+namespace {
+
+using nlohmann::json;
+
+// A user's class that never calls publishObject(), with state of its own written after the
+// PhysicalObject part is complete.
+class Fixture : public rp::PhysicalObject {
+ public:
+  explicit Fixture(const std::string& name) : rp::PhysicalObject(name) { for (auto& v : values_) v = 1.0; }
+  ~Fixture() override { for (auto& v : values_) v = -1.0; }
+
+ private:
+  double values_[64];
+};
+
+}  // namespace
+RP_REGISTER_CLASS(Fixture);
+namespace {
+
+json objectNamed(const rp::internal::SceneState& s, const std::string& name) {
+  const json scene = json::parse(s.sceneMessage());
+  for (const json& o : scene["objects"])
+    if (o["name"] == name) return o;
+  return nullptr;
+}
+
+// The base-frame pose of every object in a state frame, by scene index.
+std::map<std::uint32_t, rp::Transform> framePoses(const std::string& frame) {
+  std::size_t at = 0;
+  auto u32 = [&] {
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(static_cast<unsigned char>(frame[at + i])) << (8 * i);
+    at += 4;
+    return v;
+  };
+  auto f64 = [&] {
+    std::uint64_t bits = 0;
+    for (int i = 0; i < 8; ++i) bits |= static_cast<std::uint64_t>(static_cast<unsigned char>(frame[at + i])) << (8 * i);
+    at += 8;
+    double v;
+    std::memcpy(&v, &bits, 8);
+    return v;
+  };
+  EXPECT_EQ(u32(), rp::internal::kStateFrameMagic);
+  (void)u32();  // protocol
+  (void)u32();  // version
+  const std::uint32_t count = u32();
+  (void)f64();  // time
+  std::map<std::uint32_t, rp::Transform> poses;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const std::uint32_t index = u32(), n = u32(), values = u32();
+    (void)u32();  // error
+    for (std::uint32_t p = 0; p < n; ++p) {
+      rp::Transform t;
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) t(r, c) = f64();
+      if (p == 0) poses[index] = t;
+    }
+    at += 8 * values;
+  }
+  return poses;
+}
+
+int indexOf(const rp::internal::SceneState& s, const std::string& name) {
+  const json scene = json::parse(s.sceneMessage());
+  for (std::size_t i = 0; i < scene["objects"].size(); ++i)
+    if (scene["objects"][i]["name"] == name) return static_cast<int>(i);
+  return -1;
+}
+
+TEST(UnpublishedObjects, ArePlacedAsRpCfgSaysAndFollowTheirMount) {
+  rp::RoboticPlatform::setSimulationModeOn();
+  rp::RoboticPlatform::setConfiguration(rp::Configuration::parse("[table]\nclass Fixture\nposition 500 -100 200\norientation 0 0 90\n", "rp.cfg"));
+  Fixture table("table");  // configured by rp.cfg, never published by its class
+  rp::Puma560 puma("puma");
+  Fixture tool("tool");
+  tool.setConnection(puma, "endEffector");
+  tool.setTransform(rp::translation(0, 0, 0.05));
+  ASSERT_FALSE(table.isObjectPublished());
+  ASSERT_FALSE(tool.isObjectPublished());
+
+  rp::internal::SceneState scene;
+  scene.refresh();
+  const json t = objectNamed(scene, "table");
+  ASSERT_TRUE(t.is_object()) << scene.sceneMessage();
+  EXPECT_EQ(t["kind"], "physical");
+  EXPECT_EQ(t["published"], false);
+  EXPECT_EQ(t["frames"], json::array({"base"}));
+  ASSERT_EQ(t["shapes"].size(), 1u);
+  EXPECT_EQ(t["shapes"][0]["kind"], "box");  // PhysicalObject's own look: a 0.1 m cube
+  EXPECT_EQ(t["shapes"][0]["size"], json::array({0.1, 0.1, 0.1}));
+  const json m = objectNamed(scene, "tool");
+  ASSERT_TRUE(m.is_object());
+  EXPECT_EQ(m["connection"], (json{{"object", "puma"}, {"frame", "endEffector"}}));
+
+  const std::map<std::uint32_t, rp::Transform> poses = framePoses(scene.buildFrame());
+  const auto tp = poses.find(static_cast<std::uint32_t>(indexOf(scene, "table")));
+  ASSERT_NE(tp, poses.end()) << "the table has a pose in the state frames";
+  const rp::Transform expectedTable = rp::translation(0.5, -0.1, 0.2) * rp::rpyToTransform(0, 0, M_PI / 2);
+  EXPECT_LT((tp->second - expectedTable).cwiseAbs().maxCoeff(), 1e-12) << tp->second;
+  const auto mp = poses.find(static_cast<std::uint32_t>(indexOf(scene, "tool")));
+  ASSERT_NE(mp, poses.end());
+  const rp::Transform expectedTool = puma.getEndEffectorTransform() * rp::translation(0, 0, 0.05);
+  EXPECT_LT((mp->second - expectedTool).cwiseAbs().maxCoeff(), 1e-6) << mp->second << "\n" << expectedTool;
+
+  // Published later, it is described by its class as any published object.
+  table.publishObject();
+  scene.refresh();
+  EXPECT_EQ(objectNamed(scene, "table")["className"], "Fixture");
+  EXPECT_NE(objectNamed(scene, "table")["published"], false);
+  tool.clearConnection();
+}
+
+TEST(UnpublishedObjects, AReaderNeverTouchesAnObjectBeingConstructedOrDestroyed) {
+  rp::RoboticPlatform::setConfiguration(rp::Configuration());
+  std::atomic<bool> stop{false};
+  std::atomic<int> drawn{0};
+  std::thread reader([&] {
+    rp::internal::SceneState scene;
+    while (!stop.load()) {
+      scene.refresh();
+      (void)scene.buildFrame();
+      const json parsed = json::parse(scene.sceneMessage());
+      for (const json& o : parsed["objects"])
+        if (o["name"].get<std::string>().rfind("fixture_", 0) == 0 && o["kind"] == "physical") drawn.fetch_add(1);
+    }
+  });
+  // Objects come and go while the reader draws them (until it has seen 20, at most 20,000).
+  for (int i = 0; i < 20000 && drawn.load() < 20; ++i) {
+    auto f = std::make_unique<Fixture>("fixture_" + std::to_string(i));
+    f->setTransform(rp::translation(0.001 * (i % 100), 0, 0));
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  stop.store(true);
+  reader.join();
+  EXPECT_GT(drawn.load(), 0) << "the reader drew some of the objects";
+}
+
+}  // namespace
