@@ -52,6 +52,20 @@ json shapeJson(const Shape& s) {
               {"color", {s.color.r, s.color.g, s.color.b, s.color.a}}};
 }
 
+// An object not published, of which only the name is read: no class, state, panel or commands.
+json listedByName(const std::string& name) {
+  return {{"path", "/objects/" + name},
+          {"name", name},
+          {"className", ""},
+          {"kind", "unpublished"},
+          {"published", false},
+          {"physical", false},
+          {"hasControlLoop", false},
+          {"error", {{"code", 0}, {"message", ""}}},
+          {"commands", json::array()},
+          {"panel", {{"title", name}, {"fields", json::array()}}}};
+}
+
 const char* displayName(DisplayMode m) {
   switch (m) {
     case DisplayMode::Off: return "off";
@@ -334,16 +348,7 @@ bool SceneState::refresh() {
       objects.push_back(describeUnpublished(v->second, byName));
       unpublishedIndex_[name] = static_cast<int>(objects.size()) - 1;
     } else {
-      objects.push_back({{"path", "/objects/" + name},
-                         {"name", name},
-                         {"className", ""},
-                         {"kind", "unpublished"},
-                         {"published", false},
-                         {"physical", false},
-                         {"hasControlLoop", false},
-                         {"error", {{"code", 0}, {"message", ""}}},
-                         {"commands", json::array()},
-                         {"panel", {{"title", name}, {"fields", json::array()}}}});
+      objects.push_back(listedByName(name));
     }
   }
   for (auto it = entries_.begin(); it != entries_.end();)
@@ -484,20 +489,14 @@ json SceneState::describeUnpublished(const PhysicalObjectView& v, const std::map
   std::string mount = v.mountName;
   for (const auto& [name, object] : published)
     if (v.mount != nullptr && object == static_cast<const RoboticObject*>(v.mount)) mount = name;
-  return {{"path", "/objects/" + v.name},
-          {"name", v.name},
-          {"className", ""},
-          {"kind", "physical"},
-          {"published", false},
-          {"physical", true},
-          {"hasControlLoop", false},
-          {"error", {{"code", 0}, {"message", ""}}},
-          {"commands", json::array()},
-          {"panel", {{"title", v.name}, {"fields", json::array()}}},
-          {"frames", json::array({"base"})},
-          {"shapes", shapes},
-          {"display", displayName(v.display)},
-          {"connection", mount.empty() ? json(nullptr) : json{{"object", mount}, {"frame", v.mountFrame}}}};
+  json j = listedByName(v.name);
+  j["kind"] = "physical";
+  j["physical"] = true;
+  j["frames"] = json::array({"base"});
+  j["shapes"] = shapes;
+  j["display"] = displayName(v.display);
+  j["connection"] = mount.empty() ? json(nullptr) : json{{"object", mount}, {"frame", v.mountFrame}};
+  return j;
 }
 
 }  // namespace rp::internal
