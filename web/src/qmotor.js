@@ -28,6 +28,7 @@ let frozen = false; // paused, zoomed or panned: the plot shows what it showed
 const modeEl = document.getElementById('plot-mode');
 const cursorEl = document.getElementById('plot-cursor');
 let cursor = null; // { t, values: { label: value } } under the mouse
+let lastFrame = null; // the latest state frame (every object's values)
 
 function freeze(why) {
   // The plot keeps a copy of the samples it shows: new ones go on arriving in `data`.
@@ -152,7 +153,9 @@ const conn = new Connection({
   onScene: (s) => {
     const first = !scene;
     scene = s;
-    const candidates = s.objects.filter((o) => o.panel.fields.some((f) => f.stateIndex >= 0));
+    // Objects with values to plot, and every object that runs a control program (to start,
+    // stop, tune and log it).
+    const candidates = s.objects.filter((o) => o.hasControlLoop || o.panel.fields.some((f) => f.stateIndex >= 0));
     select.replaceChildren(...candidates.map((o) => new Option(`${o.name} (${o.className})`, o.name)));
     if (first || !candidates.some((o) => o.name === objectName)) {
       choose(objectName && candidates.some((o) => o.name === objectName) ? objectName : candidates[0] && candidates[0].name);
@@ -163,6 +166,7 @@ const conn = new Connection({
     }
   },
   onFrame: (f) => {
+    lastFrame = f;
     if (!scene || !plot) return;
     const o = f.objects.find((x) => scene.objects[x.index] && scene.objects[x.index].name === objectName);
     if (!o) return;
@@ -196,6 +200,7 @@ window.rp = {
   get plot() { return plot; },
   get frozen() { return frozen; },
   get cursor() { return cursor; },
+  get lastFrame() { return lastFrame; },
 };
 
 // ---- Log variables: plots of any column of the program's log file, and start/stop logging ----
