@@ -417,6 +417,7 @@ function showProgramStatus(s) {
   }
   const c = s.capture;
   if (!c.armed) progEl.capState.textContent = 'not armed';
+  else if (!c.triggered && !c.trigger) progEl.capState.textContent = 'armed: from the next cycle';
   else if (!c.triggered) progEl.capState.textContent = `armed: waiting for ${c.trigger.column} ${c.trigger.edge} through ${c.trigger.level}`;
   else progEl.capState.textContent = `${c.rows} of ${c.capacity} rows${c.rows === c.capacity ? ' (full)' : ''}, every ${c.every} cycles, from t = ${c.triggerTime.toFixed(3)} s`;
   progEl.capState.className = c.armed && c.triggered && c.rows < c.capacity ? 'on' : 'off';
