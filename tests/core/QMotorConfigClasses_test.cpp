@@ -78,6 +78,16 @@ class QMotorConfigClasses : public ::testing::Test {
     RoboticPlatform::setConfiguration(Configuration::read((dir_ / "rp.cfg").string()));
   }
   std::string path(const std::string& f) const { return (dir_ / f).string(); }
+  // The ConfigError message of `create`, or "no error".
+  template <typename F>
+  static std::string configError(F create) {
+    try {
+      create();
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "no error";
+  }
   std::filesystem::path dir_;
 };
 
@@ -97,13 +107,9 @@ TEST_F(QMotorConfigClasses, AGripperCreatedByNameGetsItsFileBeforeTheLoopStarts)
 TEST_F(QMotorConfigClasses, AnUnknownKeyInAGrippersFileIsAnErrorWithFileAndLine) {
   configure("[hand]\nclass QmForceGripper\nqmotorConfig hand.cfg\n", "maxForce 55\nmaxForse 60\n");
   ObjectManager om;
-  try {
-    om.createDerivedObject<Gripper>("hand");
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), path("hand.cfg") + ":2: 'maxForse' is not a parameter of hand (known: rate, "
-                                                       "priority, logEvery, logBufferSize, log, maxForce)");
-  }
+  EXPECT_EQ(configError([&] { om.createDerivedObject<Gripper>("hand"); }),
+            path("hand.cfg") + ":2: 'maxForse' is not a parameter of hand (known: rate, priority, logEvery, "
+                               "logBufferSize, log, maxForce)");
   EXPECT_EQ(om.findObject("hand"), nullptr) << "the object was not kept";
 }
 
@@ -113,28 +119,18 @@ TEST_F(QMotorConfigClasses, ASensorConstructedByTheProgramGetsItsFile) {
   EXPECT_EQ(sensor.cutoff, 42.5);
   EXPECT_TRUE(sensor.isRunning());
   configure("[filter2]\nclass QmFilteredSensor\nqmotorConfig hand.cfg\n", "cutoff 5000\n");
-  try {
-    FilteredSensor bad("filter2");
-    FAIL() << "no error";
-  } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              path("hand.cfg") + ":1: ControlProgram filter2: parameter 'cutoff' = 5000.000000 is outside [0.100000, "
-                                 "1000.000000] Hz");
-  }
+  EXPECT_EQ(configError([] { FilteredSensor bad("filter2"); }),
+            path("hand.cfg") + ":1: ControlProgram filter2: parameter 'cutoff' = 5000.000000 is outside [0.100000, "
+                               "1000.000000] Hz");
 }
 
 TEST_F(QMotorConfigClasses, AClassThatRunsNoControlProgramRefusesTheFileAtTheRpCfgLine) {
   configure("[gripper]\nclass DefaultGripper\nposition 0 0 0\nqmotorConfig hand.cfg\n", "maxForce 55\n");
   ObjectManager om;
-  try {
-    om.createDerivedObject<Gripper>("gripper");
-    FAIL() << "no error: the file would be ignored";
-  } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), path("rp.cfg") + ":4: setting 'qmotorConfig': gripper (DefaultGripper) runs no "
-                                                      "control program, so nothing would apply '" + path("hand.cfg") +
-                                                      "' (only a class that runs one, e.g. derived from ControlProgram, "
-                                                      "takes the file)");
-  }
+  EXPECT_EQ(configError([&] { om.createDerivedObject<Gripper>("gripper"); }),
+            path("rp.cfg") + ":4: setting 'qmotorConfig': gripper (DefaultGripper) runs no control program, so nothing "
+                             "would apply '" + path("hand.cfg") +
+                "' (only a class that runs one, e.g. derived from ControlProgram, takes the file)");
 }
 
 }  // namespace

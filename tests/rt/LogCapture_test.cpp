@@ -51,6 +51,18 @@ std::vector<std::vector<std::string>> csvRows(const std::string& csv) {
   return rows;
 }
 
+LogCaptureSettings triggered(std::vector<std::string> variables, std::size_t samples, unsigned every,
+                             const std::string& column, double level, bool rising) {
+  LogCaptureSettings s;
+  s.variables = std::move(variables);
+  s.samples = samples;
+  s.every = every;
+  s.triggerColumn = column;
+  s.triggerLevel = level;
+  s.triggerRising = rising;
+  return s;
+}
+
 void run(Ramp& r, SimulatedClock& clock, std::uint64_t cycles) {
   r.setClock(clock);
   r.setCycleLimit(cycles);
@@ -88,12 +100,7 @@ TEST(LogCapture, ChosenColumnsAtTheChosenDecimationUntilFull) {
 TEST(LogCapture, RisingTriggerStartsTheLogInTheCycleOfTheCrossing) {
   SimulatedClock clock(1e-3);
   Ramp r;
-  LogCaptureSettings s;
-  s.variables = {"x"};
-  s.samples = 5;
-  s.every = 2;
-  s.triggerColumn = "q[2]";  // 2x crosses 51 between x = 25 and x = 26
-  s.triggerLevel = 51;
+  LogCaptureSettings s = triggered({"x"}, 5, 2, "q[2]", 51, true);  // 2x crosses 51 between x = 25 and x = 26
   r.setLogCapture(s);
   run(r, clock, 200);
   const LogCaptureStatus st = r.getLogCaptureStatus();
@@ -116,12 +123,7 @@ TEST(LogCapture, RisingTriggerStartsTheLogInTheCycleOfTheCrossing) {
 TEST(LogCapture, FallingTriggerAndATriggerThatNeverFires) {
   SimulatedClock clock(1e-3);
   Ramp r;
-  LogCaptureSettings s;
-  s.variables = {"wave"};
-  s.samples = 3;
-  s.triggerColumn = "wave";  // sin(x/10) falls through 0 at x = 10 pi = 31.4
-  s.triggerLevel = 0;
-  s.triggerRising = false;
+  LogCaptureSettings s = triggered({"wave"}, 3, 1, "wave", 0, false);  // sin(x/10) falls through 0 at x = 10 pi
   r.setLogCapture(s);
   run(r, clock, 100);
   auto rows = csvRows(r.getLogCaptureCsv());
