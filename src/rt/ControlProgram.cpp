@@ -372,10 +372,19 @@ struct ControlProgram::Impl {
     }
   }
 
+  // The first tick of a run on the simulated clock: the next multiple of the period, and after
+  // the ticks of an earlier run (started again after a stop, the clock may not have moved on: its
+  // first cycle would have the time of the last one).
+  std::uint64_t nextTick = 0;
+  std::uint64_t firstSimulatedTick(const SimulatedClock& sim, std::uint64_t ticksPerCycle) const {
+    const std::uint64_t now = (sim.getTick() + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle;
+    return std::max(now, (nextTick + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle);
+  }
+
   void runSimulated(SimulatedClock& sim) {
     const auto ticksPerCycle =
         static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / rate / sim.getStep())));
-    std::uint64_t tick = (sim.getTick() + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle;
+    std::uint64_t tick = firstSimulatedTick(sim, ticksPerCycle);
     std::uint64_t k = 0;
     while (sim.waitForTick(participant, tick, stopRequested)) {
       const std::int64_t start = internal::monotonicNanoseconds();
@@ -383,6 +392,7 @@ struct ControlProgram::Impl {
       computation.add(internal::monotonicNanoseconds() - start);
       waitForLogRoom();
       tick += ticksPerCycle;
+      nextTick = tick;
       if (cycleLimit && k >= cycleLimit) break;
     }
   }
@@ -450,6 +460,7 @@ int ControlProgram::getPriority() const { return impl_->priority; }
 void ControlProgram::setClock(Clock& clock) {
   impl_->checkNotRunning("setClock");
   impl_->clock = &clock;
+  impl_->nextTick = 0;  // another clock: its own ticks
 }
 Clock& ControlProgram::getClock() const { return impl_->clock ? *impl_->clock : RoboticPlatform::getDefaultClock(); }
 
@@ -471,7 +482,11 @@ void ControlProgram::start() {
   d.logSamples = 0;
   d.latency.reset();
   d.computation.reset();
-  // Log channel: one column per value of every selected variable.
+  // Log channel: one column per value of every selected variable. A program started again (QMotor's
+  // Start after Stop) with the same writer and columns goes on in its own columns.
+  std::shared_ptr<LogWriter::Channel> previous = std::move(d.channel);
+  const std::vector<const double*> previousSources = std::move(d.logSources);
+  LogWriter* const previousWriter = d.writer;
   d.channel.reset();
   d.logSources.clear();
   LogWriter* writer = d.writerSet ? d.writer : LogWriter::getPlatformWriter();
@@ -490,7 +505,13 @@ void ControlProgram::start() {
       throw std::invalid_argument("ControlProgram " + d.name + ": a log buffer of " + std::to_string(d.logBufferSize) +
                                   " samples of " + std::to_string(columns.size()) +
                                   " columns needs more than 1 GiB; set a smaller logBufferSize");
-    if (!columns.empty()) d.channel = std::make_shared<LogWriter::Channel>(d.name, std::move(columns), d.logBufferSize);
+    if (!columns.empty()) {
+      if (previous && previousWriter == writer && previousSources == d.logSources &&
+          previous->capacity == std::max<std::size_t>(2, d.logBufferSize))
+        d.channel = previous;
+      else
+        d.channel = std::make_shared<LogWriter::Channel>(d.name, std::move(columns), d.logBufferSize);
+    }
   }
   d.writer = writer;
   {
@@ -503,11 +524,15 @@ void ControlProgram::start() {
   if (auto* sim = dynamic_cast<SimulatedClock*>(d.clock)) {
     sim->attach(d.participant);
     const auto m = static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / d.rate / sim->getStep())));
-    firstTime = sim->tickTime((sim->getTick() + m - 1) / m * m);
+    firstTime = sim->tickTime(d.firstSimulatedTick(*sim, m));
   } else {
     firstTime = RealClock::instance().getTime();
   }
-  if (d.channel) {
+  if (d.channel && d.channel == previous) {
+    // The writer has it: rows of other programs wait for its next sample again (its last time
+    // is before this run's first; the writer thread owns that field).
+    d.channel->finished.store(false);
+  } else if (d.channel) {
     d.channel->lastTime = std::nextafter(firstTime, -std::numeric_limits<double>::infinity());
     d.channel->any = true;
     writer->addChannel(d.channel);
