@@ -377,6 +377,7 @@ const progEl = {
 };
 let progStatus = null; // the last status of the chosen object's program
 let progResult = null; // { ok, text } of the last request
+let lastReply = null; // the last reply to a button (with the program's status at that moment)
 let capVariablesOf = ''; // the object whose variables the check boxes list
 
 function showResult(ok, text) {
@@ -430,6 +431,7 @@ async function qmotor(action, fields = {}, quiet = false) {
     const r = await conn.request({ type: 'qmotor', object: objectName, action, ...fields });
     const reply = JSON.parse(r.reply);
     if (reply.status) showProgramStatus(reply.status);
+    if (!quiet) lastReply = reply;
     if (!quiet && reply.message) showResult(true, reply.message);
     return reply;
   } catch (e) {
@@ -475,4 +477,5 @@ setInterval(() => conn.connected && qmotor('status', {}, true), 500);
 Object.defineProperties(window.rp, Object.getOwnPropertyDescriptors({
   get program() { return progStatus; },
   get result() { return progResult; },
+  get lastReply() { return lastReply; },
 }));
