@@ -9,11 +9,14 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <cmath>
 #include <stdexcept>
 #include <thread>
 #include <typeindex>
 
 #include "Registry.hpp"
+#include "rp/core/Configuration.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/PhysicalObject.hpp"
 #include "rp/core/TypeDatabase.hpp"
@@ -73,6 +76,8 @@ struct RoboticObject::Impl {
   std::vector<ExtraThread> threads;
   std::atomic<bool> threadsStarted{false};
   std::atomic<bool> stopThreads{false};
+
+  std::atomic<bool> qmotorApplied{false};  // applyQMotorConfigFile() has run
 
   std::mutex commandMutex;
   struct Command {
@@ -254,9 +259,79 @@ bool RoboticObject::handleMessage(const std::string&, const std::string&, std::s
   return false;
 }
 
+void RoboticObject::applyQMotorConfigFile() {
+  if (impl_->qmotorApplied.exchange(true)) return;
+  const ConfigSection* section = configSection();
+  if (section == nullptr || section->qmotorConfig() == nullptr) return;
+  ControlProgram* p = getControlProgram();
+  if (p == nullptr) {
+    const ConfigSetting* line = section->find("qmotorConfig");
+    const std::string what = "setting 'qmotorConfig': " + getName() + " (" + getClassName() +
+                             ") runs no control program, so nothing would apply '" +
+                             section->qmotorConfig()->fileName() +
+                             "' (only a class that runs one, e.g. derived from ControlProgram, takes the file)";
+    if (line != nullptr) throw section->errorAt(*line, what);
+    throw ConfigError(section->fileName(), section->line(), what);
+  }
+  p->applyQMotorConfig(*section->qmotorConfig());
+}
+
+std::string RoboticObject::getQMotorConfigFile() const {
+  const ConfigSection* section = configSection();
+  return section != nullptr && section->qmotorConfig() != nullptr ? section->qmotorConfig()->fileName() : std::string();
+}
+
+std::string RoboticObject::getQMotorConfigFolder() const {
+  const std::string file = getQMotorConfigFile();
+  const ConfigSection* section = configSection();
+  const std::string from = !file.empty() ? file : section != nullptr ? section->fileName() : std::string();
+  if (from.empty()) return {};
+  std::filesystem::path folder = std::filesystem::path(from).parent_path();
+  if (folder.empty()) folder = ".";
+  return folder.string();
+}
+
+namespace {
+ControlProgram& programOf(RoboticObject& o) {
+  ControlProgram* p = o.getControlProgram();
+  if (p == nullptr) throw std::invalid_argument(o.getName() + " (" + o.getClassName() + ") runs no control program");
+  return *p;
+}
+}  // namespace
+
+std::string RoboticObject::stopControlProgram() {
+  ControlProgram& p = programOf(*this);
+  if (!p.isRunning()) throw std::logic_error(getName() + ": the control program is not running");
+  p.stop();
+  return getName() + ": control program stopped after " + std::to_string(p.getCycleCount()) + " cycles";
+}
+
+std::string RoboticObject::startControlProgram() {
+  ControlProgram& p = programOf(*this);
+  if (p.isRunning()) throw std::logic_error(getName() + ": the control program is running already");
+  if (ObjectManager::isShutdownRequested())
+    throw std::logic_error(getName() + ": the system is shutting down (" + ObjectManager::getShutdownReason() + ")");
+  if (isShuttingDown()) throw std::logic_error(getName() + ": the object is shutting down");
+  if (!isObjectPublished()) throw std::logic_error(getName() + ": the object is being constructed or destroyed");
+  if (const ErrorStatus e = getErrorStatus(); e.code != 0)
+    throw std::logic_error(getName() + ": the object has an error (" + std::to_string(e.code) + ": " + e.message + ")");
+  p.start();
+  return getName() + ": control program started at " + std::to_string(static_cast<long long>(std::lround(p.getRate()))) +
+         " Hz";
+}
+
+std::string RoboticObject::restartControlProgram() {
+  ControlProgram& p = programOf(*this);
+  std::string stopped;
+  if (p.isRunning()) stopped = stopControlProgram() + "; ";
+  return stopped + startControlProgram();
+}
+
 void RoboticObject::startControlLoop() {
+  if (ControlProgram* p = getControlProgram())
+    if (p->getProgramName() == "control" && !p->isRunning()) p->setProgramName(getName());
+  applyQMotorConfigFile();
   if (ControlProgram* p = getControlProgram()) {
-    if (p->getProgramName() == "control") p->setProgramName(getName());
     if (!p->isRunning() && !impl_->threadsStarted.load()) p->start();  // once: a stopped loop stays stopped
   }
   startThreads();

@@ -33,6 +33,7 @@
 #include <thread>
 
 #include "OpenInBrowser.hpp"
+#include "QMotorRequests.hpp"
 #include "SceneState.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/PhysicalObject.hpp"
@@ -845,6 +846,19 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
       json now = p->getParameter(name);
       return now.dump();
     };
+  } else if (type == "qmotor") {
+    // QMotor: start/stop/restart the object's control program, save/load its control-program
+    // files, QMotor's log. Every field is checked here; the object is touched in the worker.
+    internal::QMotorRequest request;
+    try {
+      request = internal::parseQMotorRequest(msg);
+    } catch (const std::exception& e) {
+      return refuse(e.what());
+    }
+    action = [object, request = std::move(request)] {
+      ObjectReference o = publishedObject(object);
+      return internal::runQMotorRequest(*o, request);
+    };
   } else if (type == "message") {
     std::string messageType;
     if (!str("messageType", messageType)) return;
@@ -862,8 +876,8 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     };
   } else {
     return refuse("unknown message type '" + type +
-                  "' (known: hello, ping, scene, command, display, setParameter, message, meshFailed, emergencyStop, logInfo, "
-                  "logging, logSubscribe)");
+                  "' (known: hello, ping, scene, command, display, setParameter, qmotor, message, meshFailed, emergencyStop, "
+                  "logInfo, logging, logSubscribe)");
   }
 
   std::weak_ptr<WsSession> weak = session;

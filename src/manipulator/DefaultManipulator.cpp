@@ -314,9 +314,7 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
                     "derivative gains of the default position control");
   registerParameter("ki", defaultControl_->getKi().data(), static_cast<std::size_t>(n), 0, 1e8, "N m/(rad s)",
                     "integral gains of the default position control");
-  if (const ConfigSection* section = configSection(); section != nullptr && section->qmotorConfig() != nullptr) {
-    applyQMotorConfig(*section->qmotorConfig());
-  }
+  applyQMotorConfigFile();  // (once: startControlLoop() does not apply it again)
   addOperatorCommands();
 }
 
@@ -590,6 +588,39 @@ void DefaultManipulator::holdUntilSafe() {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kShutdownTimeout + 2.0);
   while (isRunning() && !loopEnded_.load() && shutdownPhase_.load() != 2 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::microseconds(500));
+}
+
+std::string DefaultManipulator::stopControlProgram() {
+  if (!isRunning()) throw std::logic_error(getName() + ": the control program is not running");
+  const bool powered = isArmPowerOn();
+  holdUntilSafe();  // at rest, power off, brakes on (as in a shutdown: shutdown phase 2)
+  std::string result = RoboticObject::stopControlProgram();
+  // Asked for by the operator, not a shutdown: the arm may be started again. After a fault (an
+  // error, or a system shutdown) the phase stays: the arm cannot be started again.
+  if (!ObjectManager::isShutdownRequested() && getErrorCode() == 0) {
+    shutdownPhase_.store(0);  // the loop has ended: its own variables are this thread's now
+    shutdownStart_ = 0;
+    restTime_ = 0;
+  }
+  const JointVector q = getJointPosition();
+  char joints[256] = "";
+  for (int i = 0, at = 0; i < q.size() && at < static_cast<int>(sizeof joints) - 16; ++i)
+    at += std::snprintf(joints + at, sizeof joints - static_cast<std::size_t>(at), "%s%.2f", i ? " " : "", q(i) * 180 / M_PI);
+  return result + (powered ? "; the arm came to rest, is braked and powered off at q = [" : "; the arm is braked at q = [") +
+         joints + "] deg";
+}
+
+std::string DefaultManipulator::startControlProgram() {
+  if (isRunning()) throw std::logic_error(getName() + ": the control program is running already");
+  if (shutdownPhase_.load() != 0) throw std::logic_error(getName() + ": the arm was shut down (a fault or a system shutdown)");
+  std::string why;
+  if (powerRequested_.load() && generator_.load() != nullptr) {
+    powerRequested_.store(false);
+    why = " (a trajectory generator drives the arm: its program powers it on, or release the generator first)";
+  }
+  const bool power = powerRequested_.load();
+  std::string result = RoboticObject::startControlProgram();
+  return result + (power ? "; the arm holds where it is (power on)" : "; the arm stays braked where it is (power off)" + why);
 }
 
 bool DefaultManipulator::isShutdownComplete() const { return shutdownPhase_.load() == 2; }

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -104,6 +105,22 @@ std::once_flag memoryLocked;
 }  // namespace
 }  // namespace internal
 
+// The name of value `i` of log variable `v`: `program.name` or `program.name[i]` (the log's
+// column), or without the program `name` / `name[i]`.
+namespace {
+std::string valueName(const std::string& program, const LogVariableInfo& v, std::size_t i) {
+  std::string column = program;
+  if (!column.empty()) column += '.';
+  column += v.name;
+  if (v.vector) {
+    column += '[';
+    column += std::to_string(i);
+    column += ']';
+  }
+  return column;
+}
+}  // namespace
+
 struct ControlProgram::Impl {
   explicit Impl(ControlProgram& p) : self(p) {}
   ControlProgram& self;
@@ -146,6 +163,63 @@ struct ControlProgram::Impl {
   std::shared_ptr<LogWriter::Channel> channel;
   std::vector<const double*> logSources;  // flattened, one per column (built in start())
 
+  // QMotor's log (setLogCapture()): built and freed outside the loop; the loop only reads the
+  // pointer `capture` and writes rows into the preallocated buffer.
+  struct Capture {
+    std::vector<const double*> sources;  // one per column
+    std::vector<std::string> columns;    // full CSV names
+    LogCaptureSettings settings;
+    std::size_t width = 0;               // 1 + columns
+    std::unique_ptr<double[]> rows;      // capacity × width
+    const double* trigger = nullptr;     // the trigger column's value, or none
+    std::atomic<std::size_t> count{0};   // rows written (release: a row is complete)
+    std::atomic<bool> triggered{false};
+    std::atomic<double> triggerTime{0};
+    double previous = std::numeric_limits<double>::quiet_NaN();  // loop only
+    std::uint64_t sinceTrigger = 0;                              // loop only
+
+    // Real-time: one cycle's sample (no allocation, no lock).
+    void sample(double t) noexcept {
+      if (!triggered.load(std::memory_order_relaxed)) {
+        if (trigger != nullptr) {
+          const double v = *trigger, level = settings.triggerLevel;
+          const bool crossed = settings.triggerRising ? (previous < level && v >= level) : (previous > level && v <= level);
+          previous = v;
+          if (!crossed) return;
+        }
+        triggerTime.store(t, std::memory_order_relaxed);
+        triggered.store(true, std::memory_order_release);
+        sinceTrigger = 0;
+      }
+      if (sinceTrigger++ % settings.every != 0) return;
+      const std::size_t n = count.load(std::memory_order_relaxed);
+      if (n >= settings.samples) return;
+      double* row = rows.get() + n * width;
+      row[0] = t;
+      for (std::size_t i = 0; i + 1 < width; ++i) row[i + 1] = *sources[i];
+      count.store(n + 1, std::memory_order_release);
+    }
+  };
+  mutable std::mutex captureMutex;        // setLogCapture() and the readers (never the loop)
+  std::shared_ptr<Capture> captureOwner;  // with captureMutex
+  std::atomic<Capture*> capture{nullptr};
+  std::atomic<bool> captureInUse{false};  // the loop holds `capture` (a one-slot hazard pointer)
+
+  // Real-time: QMotor's log sample of this cycle.
+  void sampleCapture(double t) noexcept {
+    captureInUse.store(true);  // sequentially consistent with the swap in setLogCapture()
+    if (Capture* c = capture.load()) c->sample(t);
+    captureInUse.store(false, std::memory_order_release);
+  }
+
+  // Replaces the capture the loop sees by `next` and returns once the loop has let go of the old one.
+  void swapCapture(std::shared_ptr<Capture> next) {
+    std::lock_guard<std::mutex> lock(captureMutex);
+    capture.exchange(next.get());
+    while (captureInUse.load()) std::this_thread::yield();
+    captureOwner = std::move(next);  // the old one is freed here, by this thread
+  }
+
   // Parameters.
   struct Param {
     ParameterInfo info;
@@ -185,12 +259,17 @@ struct ControlProgram::Impl {
     }
   }
 
-  void request(Param& p, const std::vector<double>& values) {
+  // Throws std::out_of_range if a value is outside the parameter's range.
+  void checkRange(const Param& p, const std::vector<double>& values) const {
     for (double v : values)
       if (!(v >= p.info.min && v <= p.info.max))
         throw std::out_of_range("ControlProgram " + name + ": parameter '" + p.info.name + "' = " + std::to_string(v) +
                                 " is outside [" + std::to_string(p.info.min) + ", " + std::to_string(p.info.max) + "]" +
                                 (p.info.unit.empty() ? "" : " " + p.info.unit));
+  }
+
+  void request(Param& p, const std::vector<double>& values) {
+    checkRange(p, values);
     std::lock_guard<std::mutex> lock(paramMutex);
     p.requested = values;
     if (!running.load()) {
@@ -211,6 +290,7 @@ struct ControlProgram::Impl {
     time.store(t, std::memory_order_relaxed);
     applyParameters();
     self.control();
+    sampleCapture(t);
     if (channel && k % logEvery == 0) {
       if (double* slot = channel->beginPush()) {
         slot[0] = t;
@@ -292,10 +372,19 @@ struct ControlProgram::Impl {
     }
   }
 
+  // The first tick of a run on the simulated clock: the next multiple of the period, and after
+  // the ticks of an earlier run (started again after a stop, the clock may not have moved on: its
+  // first cycle would have the time of the last one).
+  std::uint64_t nextTick = 0;
+  std::uint64_t firstSimulatedTick(const SimulatedClock& sim, std::uint64_t ticksPerCycle) const {
+    const std::uint64_t now = (sim.getTick() + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle;
+    return std::max(now, (nextTick + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle);
+  }
+
   void runSimulated(SimulatedClock& sim) {
     const auto ticksPerCycle =
         static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / rate / sim.getStep())));
-    std::uint64_t tick = (sim.getTick() + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle;
+    std::uint64_t tick = firstSimulatedTick(sim, ticksPerCycle);
     std::uint64_t k = 0;
     while (sim.waitForTick(participant, tick, stopRequested)) {
       const std::int64_t start = internal::monotonicNanoseconds();
@@ -303,6 +392,7 @@ struct ControlProgram::Impl {
       computation.add(internal::monotonicNanoseconds() - start);
       waitForLogRoom();
       tick += ticksPerCycle;
+      nextTick = tick;
       if (cycleLimit && k >= cycleLimit) break;
     }
   }
@@ -370,6 +460,7 @@ int ControlProgram::getPriority() const { return impl_->priority; }
 void ControlProgram::setClock(Clock& clock) {
   impl_->checkNotRunning("setClock");
   impl_->clock = &clock;
+  impl_->nextTick = 0;  // another clock: its own ticks
 }
 Clock& ControlProgram::getClock() const { return impl_->clock ? *impl_->clock : RoboticPlatform::getDefaultClock(); }
 
@@ -391,7 +482,11 @@ void ControlProgram::start() {
   d.logSamples = 0;
   d.latency.reset();
   d.computation.reset();
-  // Log channel: one column per value of every selected variable.
+  // Log channel: one column per value of every selected variable. A program started again (QMotor's
+  // Start after Stop) with the same writer and columns goes on in its own columns.
+  std::shared_ptr<LogWriter::Channel> previous = std::move(d.channel);
+  const std::vector<const double*> previousSources = std::move(d.logSources);
+  LogWriter* const previousWriter = d.writer;
   d.channel.reset();
   d.logSources.clear();
   LogWriter* writer = d.writerSet ? d.writer : LogWriter::getPlatformWriter();
@@ -400,15 +495,7 @@ void ControlProgram::start() {
     for (auto& v : d.logVars) {
       if (!v.selected) continue;
       for (std::size_t i = 0; i < v.info.size; ++i) {
-        std::string column = d.name;
-        column += '.';
-        column += v.info.name;
-        if (v.info.vector) {
-          column += '[';
-          column += std::to_string(i);
-          column += ']';
-        }
-        columns.push_back(std::move(column));
+        columns.push_back(valueName(d.name, v.info, i));
         d.logSources.push_back(v.data + i);
       }
     }
@@ -418,7 +505,13 @@ void ControlProgram::start() {
       throw std::invalid_argument("ControlProgram " + d.name + ": a log buffer of " + std::to_string(d.logBufferSize) +
                                   " samples of " + std::to_string(columns.size()) +
                                   " columns needs more than 1 GiB; set a smaller logBufferSize");
-    if (!columns.empty()) d.channel = std::make_shared<LogWriter::Channel>(d.name, std::move(columns), d.logBufferSize);
+    if (!columns.empty()) {
+      if (previous && previousWriter == writer && previousSources == d.logSources &&
+          previous->capacity == std::max<std::size_t>(2, d.logBufferSize))
+        d.channel = previous;
+      else
+        d.channel = std::make_shared<LogWriter::Channel>(d.name, std::move(columns), d.logBufferSize);
+    }
   }
   d.writer = writer;
   {
@@ -431,11 +524,15 @@ void ControlProgram::start() {
   if (auto* sim = dynamic_cast<SimulatedClock*>(d.clock)) {
     sim->attach(d.participant);
     const auto m = static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / d.rate / sim->getStep())));
-    firstTime = sim->tickTime((sim->getTick() + m - 1) / m * m);
+    firstTime = sim->tickTime(d.firstSimulatedTick(*sim, m));
   } else {
     firstTime = RealClock::instance().getTime();
   }
-  if (d.channel) {
+  if (d.channel && d.channel == previous) {
+    // The writer has it: rows of other programs wait for its next sample again (its last time
+    // is before this run's first; the writer thread owns that field).
+    d.channel->finished.store(false);
+  } else if (d.channel) {
     d.channel->lastTime = std::nextafter(firstTime, -std::numeric_limits<double>::infinity());
     d.channel->any = true;
     writer->addChannel(d.channel);
@@ -524,7 +621,9 @@ std::vector<LogVariableInfo> ControlProgram::getLogVariables() const {
 
 void ControlProgram::setLogEvery(unsigned n) {
   impl_->checkNotRunning("setLogEvery");
-  if (n == 0) throw std::invalid_argument("ControlProgram::setLogEvery: n must be at least 1");
+  if (n == 0 || n > kMaxLogEvery)
+    throw std::invalid_argument("ControlProgram::setLogEvery: n must be in 1.." + std::to_string(kMaxLogEvery) + ", got " +
+                                std::to_string(n));
   impl_->logEvery = n;
 }
 unsigned ControlProgram::getLogEvery() const { return impl_->logEvery; }
@@ -540,6 +639,96 @@ void ControlProgram::setLogWriter(LogWriter* writer) {
   impl_->checkNotRunning("setLogWriter");
   impl_->writer = writer;
   impl_->writerSet = true;
+}
+
+void ControlProgram::setLogCapture(const LogCaptureSettings& settings) {
+  Impl& d = *impl_;
+  auto known = [&] {
+    std::string names;
+    for (auto& v : d.logVars) names += (names.empty() ? "" : ", ") + v.info.name;
+    return names.empty() ? std::string("none") : names;
+  };
+  if (settings.every < 1 || settings.every > kMaxLogEvery)
+    throw std::invalid_argument("'every' must be an integer in 1.." + std::to_string(kMaxLogEvery) + ", got " +
+                                std::to_string(settings.every));
+  if (!std::isfinite(settings.triggerLevel)) throw std::invalid_argument("'level' must be a finite number");
+  auto c = std::make_shared<Impl::Capture>();
+  c->settings = settings;
+  for (std::size_t k = 0; k < settings.variables.size(); ++k) {
+    const std::string& w = settings.variables[k];
+    if (std::find(settings.variables.begin(), settings.variables.begin() + static_cast<std::ptrdiff_t>(k), w) !=
+        settings.variables.begin() + static_cast<std::ptrdiff_t>(k))
+      throw std::invalid_argument("'variables': '" + w + "' is given twice");
+    if (std::none_of(d.logVars.begin(), d.logVars.end(), [&](auto& v) { return v.info.name == w; }))
+      throw std::invalid_argument("'variables': '" + w + "' is not a log variable of " + d.name + " (known: " + known() + ")");
+  }
+  // Columns in registration order, as in the log file.
+  for (auto& v : d.logVars) {
+    if (!settings.variables.empty() &&
+        std::find(settings.variables.begin(), settings.variables.end(), v.info.name) == settings.variables.end())
+      continue;
+    for (std::size_t i = 0; i < v.info.size; ++i) {
+      c->columns.push_back(valueName(d.name, v.info, i));
+      c->sources.push_back(v.data + i);
+    }
+  }
+  if (c->columns.empty()) throw std::invalid_argument("'variables': " + d.name + " has no log variables");
+  c->width = c->columns.size() + 1;
+  const std::size_t maxRows = kMaxLogCaptureValues / c->width;
+  if (settings.samples < 1 || settings.samples > maxRows)
+    throw std::invalid_argument("'samples' must be in 1.." + std::to_string(maxRows) + " for " +
+                                std::to_string(c->columns.size()) + " columns, got " + std::to_string(settings.samples));
+  if (!settings.triggerColumn.empty()) {
+    const std::string& t = settings.triggerColumn;
+    for (auto& v : d.logVars)
+      for (std::size_t i = 0; i < v.info.size; ++i)
+        if (valueName("", v.info, i) == t) c->trigger = v.data + i;
+    if (c->trigger == nullptr)
+      throw std::invalid_argument("'trigger': '" + t + "' is not a log value of " + d.name +
+                                  " (a scalar's name or a vector's name[i]; variables: " + known() + ")");
+  }
+  c->rows.reset(new double[settings.samples * c->width]());
+  d.swapCapture(std::move(c));
+}
+
+void ControlProgram::clearLogCapture() { impl_->swapCapture(nullptr); }
+
+LogCaptureStatus ControlProgram::getLogCaptureStatus() const {
+  std::lock_guard<std::mutex> lock(impl_->captureMutex);
+  LogCaptureStatus s;
+  const Impl::Capture* c = impl_->captureOwner.get();
+  if (c == nullptr) return s;
+  s.armed = true;
+  s.triggered = c->triggered.load(std::memory_order_acquire);
+  s.triggerTime = s.triggered ? c->triggerTime.load(std::memory_order_relaxed) : 0;
+  s.rows = c->count.load(std::memory_order_acquire);
+  s.capacity = c->settings.samples;
+  s.every = c->settings.every;
+  s.columns = c->columns;
+  s.triggerColumn = c->settings.triggerColumn;
+  s.triggerLevel = c->settings.triggerLevel;
+  s.triggerRising = c->settings.triggerRising;
+  return s;
+}
+
+std::string ControlProgram::getLogCaptureCsv() const {
+  std::lock_guard<std::mutex> lock(impl_->captureMutex);
+  const Impl::Capture* c = impl_->captureOwner.get();
+  if (c == nullptr) throw std::logic_error("ControlProgram " + impl_->name + ": no QMotor log is set (setLogCapture())");
+  const std::size_t n = c->count.load(std::memory_order_acquire);
+  std::string out = "t";
+  for (const auto& column : c->columns) out += "," + column;
+  out += '\n';
+  out.reserve(out.size() + n * c->width * 12);
+  for (std::size_t r = 0; r < n; ++r) {
+    const double* row = c->rows.get() + r * c->width;
+    for (std::size_t i = 0; i < c->width; ++i) {
+      if (i) out += ',';
+      internal::appendNumber(out, row[i]);
+    }
+    out += '\n';
+  }
+  return out;
 }
 
 void ControlProgram::registerParameter(const std::string& name, double& target, double min, double max,
@@ -618,7 +807,7 @@ namespace {
 
 // Ranges of the control-program settings a qmotorConfig file may give (docs/core.md).
 constexpr double kMaxQMotorRate = ControlProgram::kMaxRate;  // Hz
-constexpr long long kMaxQMotorLogEvery = 1000000;    // cycles
+constexpr long long kMaxQMotorLogEvery = ControlProgram::kMaxLogEvery;  // cycles
 constexpr auto kMaxQMotorLogBuffer = static_cast<long long>(ControlProgram::kMaxLogBufferSize);  // samples
 
 // The one value of setting `e` as a number in (low, high] (or [low, high] when `openLow` is
@@ -656,50 +845,81 @@ long long qmotorInteger(const ParameterFile& file, const ConfigSetting& e, long 
 }  // namespace
 
 void ControlProgram::applyQMotorConfig(const ParameterFile& file) {
-  for (const auto& e : file.entries()) {
-    try {
-      if (e.name == "rate") setRate(qmotorNumber(file, e, 0, kMaxQMotorRate, true, "Hz"));
-      else if (e.name == "priority") setPriority(static_cast<int>(qmotorInteger(file, e, 1, 99)));
-      else if (e.name == "logEvery") setLogEvery(static_cast<unsigned>(qmotorInteger(file, e, 1, kMaxQMotorLogEvery)));
-      else if (e.name == "logBufferSize")
-        setLogBufferSize(static_cast<std::size_t>(qmotorInteger(file, e, 2, kMaxQMotorLogBuffer)));
-      else if (e.name == "log") {
-        impl_->checkNotRunning("applyQMotorConfig");
-        for (auto& v : impl_->logVars) v.selected = false;
-        for (const auto& w : e.values) {
-          auto it = std::find_if(impl_->logVars.begin(), impl_->logVars.end(), [&](auto& v) { return v.info.name == w; });
-          if (it == impl_->logVars.end()) {
-            std::string known;
-            for (auto& v : impl_->logVars) known += (known.empty() ? "" : ", ") + v.info.name;
-            throw file.errorAt(e, "'log': '" + ConfigError::excerpt(w) + "' is not a log variable of " + impl_->name +
-                                      " (known: " + (known.empty() ? "none" : known) + ")");
+  Impl& d = *impl_;
+  // A setting may change only while the program is stopped; a file giving its current value (as
+  // saveQMotorConfig() writes it) is accepted while running.
+  auto setting = [&](const ConfigSetting& e, bool same, bool apply, const std::function<void()>& set) {
+    if (d.running.load()) {
+      if (!same)
+        throw file.errorAt(e, "'" + e.name + "' cannot change while " + d.name +
+                                  " runs (stop the program, then load the file again)");
+      return;
+    }
+    if (apply) set();
+  };
+  // Pass 0 checks every line, pass 1 applies them: a bad file changes nothing.
+  for (int pass = 0; pass < 2; ++pass) {
+    const bool apply = pass == 1;
+    for (const auto& e : file.entries()) {
+      try {
+        if (e.name == "rate") {
+          const double v = qmotorNumber(file, e, 0, kMaxQMotorRate, true, "Hz");
+          setting(e, v == d.rate, apply, [&] { setRate(v); });
+        } else if (e.name == "priority") {
+          const int v = static_cast<int>(qmotorInteger(file, e, 1, 99));
+          setting(e, v == d.priority, apply, [&] { setPriority(v); });
+        } else if (e.name == "logEvery") {
+          const auto v = static_cast<unsigned>(qmotorInteger(file, e, 1, kMaxQMotorLogEvery));
+          setting(e, v == d.logEvery, apply, [&] { setLogEvery(v); });
+        } else if (e.name == "logBufferSize") {
+          const auto v = static_cast<std::size_t>(qmotorInteger(file, e, 2, kMaxQMotorLogBuffer));
+          setting(e, v == d.logBufferSize, apply, [&] { setLogBufferSize(v); });
+        } else if (e.name == "log") {
+          std::vector<bool> selected(d.logVars.size(), false);
+          for (const auto& w : e.values) {
+            auto it = std::find_if(d.logVars.begin(), d.logVars.end(), [&](auto& v) { return v.info.name == w; });
+            if (it == d.logVars.end()) {
+              std::string known;
+              for (auto& v : d.logVars) known += (known.empty() ? "" : ", ") + v.info.name;
+              throw file.errorAt(e, "'log': '" + ConfigError::excerpt(w) + "' is not a log variable of " + d.name +
+                                        " (known: " + (known.empty() ? "none" : known) + ")");
+            }
+            selected[static_cast<std::size_t>(it - d.logVars.begin())] = true;
           }
-          it->selected = true;
+          bool same = true;
+          for (std::size_t i = 0; i < d.logVars.size(); ++i) same = same && selected[i] == d.logVars[i].selected;
+          setting(e, same, apply, [&] {
+            for (std::size_t i = 0; i < d.logVars.size(); ++i) d.logVars[i].selected = selected[i];
+          });
+        } else {
+          bool known = false;
+          for (auto& p : d.params) known = known || p->info.name == e.name;
+          if (!known) {
+            std::string names = "rate, priority, logEvery, logBufferSize, log";
+            for (auto& p : d.params) names += ", " + p->info.name;
+            throw file.errorAt(e, "'" + ConfigError::excerpt(e.name) + "' is not a parameter of " + d.name +
+                                      " (known: " + names + ")");
+          }
+          std::vector<double> values;
+          for (const auto& v : e.values) {
+            double x = 0;
+            if (!internal::parseNumber(v, x) || !std::isfinite(x))
+              throw file.errorAt(e, "'" + e.name + "': '" + ConfigError::excerpt(v) + "' is not a finite number");
+            values.push_back(x);
+          }
+          Impl::Param& p = d.findParam(e.name);
+          if (values.size() == 1 && p.info.size > 1) values.assign(p.info.size, values[0]);
+          if (values.size() != p.info.size)
+            throw file.errorAt(e, "ControlProgram " + d.name + ": parameter '" + e.name + "' needs " +
+                                      std::to_string(p.info.size) + " values, got " + std::to_string(values.size()));
+          d.checkRange(p, values);
+          if (apply) setParameter(e.name, values);
         }
-      } else {
-        bool known = false;
-        for (auto& p : impl_->params) known = known || p->info.name == e.name;
-        if (!known) {
-          std::string names = "rate, priority, logEvery, logBufferSize, log";
-          for (auto& p : impl_->params) names += ", " + p->info.name;
-          throw file.errorAt(e, "'" + ConfigError::excerpt(e.name) + "' is not a parameter of " + impl_->name +
-                                    " (known: " + names + ")");
-        }
-        std::vector<double> values;
-        for (const auto& v : e.values) {
-          double d = 0;
-          if (!internal::parseNumber(v, d) || !std::isfinite(d))
-            throw file.errorAt(e, "'" + e.name + "': '" + ConfigError::excerpt(v) + "' is not a finite number");
-          values.push_back(d);
-        }
-        Impl::Param& p = impl_->findParam(e.name);
-        if (values.size() == 1 && p.info.size > 1) values.assign(p.info.size, values[0]);
-        setParameter(e.name, values);
+      } catch (const ConfigError&) {
+        throw;
+      } catch (const std::exception& ex) {
+        throw file.errorAt(e, ex.what());
       }
-    } catch (const ConfigError&) {
-      throw;
-    } catch (const std::exception& ex) {
-      throw file.errorAt(e, ex.what());
     }
   }
 }

@@ -1,6 +1,7 @@
 // The single-producer ring buffer that carries one control program's log samples to a LogWriter.
 #pragma once
 #include <atomic>
+#include <charconv>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -10,6 +11,16 @@
 #include "rp/rt/LogWriter.hpp"
 
 namespace rp {
+
+namespace internal {
+// Appends `v` to a CSV line as the shortest text that reads back to the same double (the log
+// file's format; QMotor's log download uses it too).
+inline void appendNumber(std::string& out, double v) {
+  char buf[32];
+  auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, ec == std::errc() ? ptr : buf);
+}
+}  // namespace internal
 
 struct LogWriter::Channel {
   Channel(std::string programName, std::vector<std::string> columnNames, std::size_t capacitySamples)

@@ -36,11 +36,7 @@ struct Line {
   bool row;         // a row (else a header line)
 };
 
-void appendNumber(std::string& out, double v) {
-  char buf[32];
-  auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, v);  // shortest text that reads back exactly
-  out.append(buf, ec == std::errc() ? ptr : buf);
-}
+using internal::appendNumber;
 
 }  // namespace
 

@@ -142,7 +142,10 @@ describe('QMotor plot controls on work_cell -qmotor', () => {
       const d = window.rp.plot.data[0];
       return d[d.length - 1] > t + 0.2;
     }, paused.last);
-    // A drag over the plot zooms in on that span and keeps it while frames arrive.
+    // A drag over the plot zooms in on that span and keeps it while frames arrive. (Once the plot
+    // holds its 10 s its span no longer grows between the reading before and the drag: on a busy
+    // machine the drag came 0.9 s later, and the span had grown from 2.7 to 3.6 s.)
+    await waitInPage(page, () => window.rp.data[0].length >= 600, undefined, 20000);
     const over = await page.locator('#plot .u-over').boundingBox();
     const before = await shown();
     await page.mouse.move(over.x + over.width * 0.3, over.y + over.height / 2);

@@ -1,5 +1,6 @@
 // The ControlProgram cycle does not allocate: waiting for the clock, applying tuned parameters,
-// control(), and log sampling into the ring buffer, on both clocks.
+// control(), log sampling into the ring buffer, and QMotor's log (its trigger, decimation and
+// rows; also while the page sets it up again), on both clocks.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -103,6 +104,64 @@ TEST(RtRealtime, RealClockCycleDoesNotAllocate) {
   writer.close();
   std::filesystem::remove(file);
   EXPECT_EQ(c.getCycleCount(), 200u);
+  EXPECT_EQ(c.allocations.load(), 0);
+}
+
+// QMotor's log in the cycle: the trigger is evaluated every cycle until it fires, then every
+// `every`-th cycle writes a row, until the buffer is full; it is set up again while running.
+void captureWhileRunning(Counted& c, unsigned every) {
+  LogCaptureSettings s;
+  s.variables = {"x", "q"};
+  s.every = every;
+  s.samples = 500;
+  s.triggerColumn = "q[2]";
+  s.triggerLevel = 5;
+  s.triggerRising = true;
+  for (int i = 0; c.isRunning() && i < 20; ++i) {
+    // Without a trigger rows are written every `every` cycles; falling through 1e9 never fires (q
+    // grows): the trigger is evaluated every cycle.
+    s.triggerColumn = i % 2 == 0 ? "" : "q[2]";
+    s.triggerRising = false;
+    s.triggerLevel = 1e9;
+    s.every = every + static_cast<unsigned>(i % 3);
+    c.setLogCapture(s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
+
+TEST(RtRealtime, QMotorLogTriggerAndDecimationDoNotAllocate) {
+  SimulatedClock clock(1e-3);
+  Counted c;
+  c.setClock(clock);
+  c.setLogWriter(nullptr);
+  c.setCycleLimit(20000);
+  LogCaptureSettings s;
+  s.every = 7;
+  s.samples = 1000;
+  s.triggerColumn = "x";
+  s.triggerLevel = 100.5;
+  c.setLogCapture(s);  // armed before the start: the first cycles evaluate the trigger
+  c.start();
+  c.waitUntilStopped();
+  EXPECT_EQ(c.getCycleCount(), 20000u);
+  EXPECT_EQ(c.allocations.load(), 0);
+  // The trigger fired at x = 101 (cycle 101), then a row every 7 cycles until the buffer was full.
+  const LogCaptureStatus st = c.getLogCaptureStatus();
+  EXPECT_TRUE(st.triggered);
+  EXPECT_NEAR(st.triggerTime, 0.101, 1e-12);
+  EXPECT_EQ(st.rows, 1000u);
+}
+
+TEST(RtRealtime, QMotorLogOnTheRealClockDoesNotAllocate) {
+  Counted c;
+  c.setClock(RealClock::instance());
+  c.setRate(2000);
+  c.setLogWriter(nullptr);
+  c.setCycleLimit(400);
+  c.start();
+  captureWhileRunning(c, 2);
+  c.waitUntilStopped();
+  EXPECT_EQ(c.getCycleCount(), 400u);
   EXPECT_EQ(c.allocations.load(), 0);
 }
 

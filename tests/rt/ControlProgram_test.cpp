@@ -145,6 +145,38 @@ TEST(ControlProgramThreads, ProgramsOnOneSimulatedClockRunInLockstep) {
   EXPECT_EQ(clock.getNumberOfPrograms(), 0);
 }
 
+// Started again after a stop (QMotor's Start), a program goes on in its own columns of the log
+// file (not as a second program 'a_2'), and its rows follow the earlier ones (on the simulated
+// clock its first cycle is the tick after its last, not the tick of the last again: that row
+// was overwritten).
+TEST(ControlProgramThreads, ARestartedProgramGoesOnInItsOwnLogColumns) {
+  auto dir = scratch("restart");
+  const auto file = dir / "log.csv";
+  {
+    LogWriter writer(file.string());
+    SimulatedClock clock(1e-3);
+    Recorder a("a");
+    a.setClock(clock);
+    a.setLogWriter(&writer);
+    a.setCycleLimit(100);
+    a.start();
+    a.waitUntilStopped();
+    a.start();
+    a.waitUntilStopped();
+    writer.close();
+  }
+  auto rows = lines(file);
+  ASSERT_EQ(rows.size(), 201u);
+  EXPECT_EQ(rows[0], "t,a.x,a.q[0],a.q[1],a.q[2]");
+  double last = -1;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const double t = std::stod(rows[i].substr(0, rows[i].find(',')));
+    EXPECT_GT(t, last) << rows[i];
+    last = t;
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ControlProgramThreads, LogRowsOnTheSimulatedClock) {
   auto dir = scratch("log");
   const auto file = dir / "log.csv";

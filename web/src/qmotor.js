@@ -28,6 +28,7 @@ let frozen = false; // paused, zoomed or panned: the plot shows what it showed
 const modeEl = document.getElementById('plot-mode');
 const cursorEl = document.getElementById('plot-cursor');
 let cursor = null; // { t, values: { label: value } } under the mouse
+let lastFrame = null; // the latest state frame (every object's values)
 
 function freeze(why) {
   // The plot keeps a copy of the samples it shows: new ones go on arriving in `data`.
@@ -152,7 +153,9 @@ const conn = new Connection({
   onScene: (s) => {
     const first = !scene;
     scene = s;
-    const candidates = s.objects.filter((o) => o.panel.fields.some((f) => f.stateIndex >= 0));
+    // Objects with values to plot, and every object that runs a control program (to start,
+    // stop, tune and log it).
+    const candidates = s.objects.filter((o) => o.hasControlLoop || o.panel.fields.some((f) => f.stateIndex >= 0));
     select.replaceChildren(...candidates.map((o) => new Option(`${o.name} (${o.className})`, o.name)));
     if (first || !candidates.some((o) => o.name === objectName)) {
       choose(objectName && candidates.some((o) => o.name === objectName) ? objectName : candidates[0] && candidates[0].name);
@@ -163,6 +166,7 @@ const conn = new Connection({
     }
   },
   onFrame: (f) => {
+    lastFrame = f;
     if (!scene || !plot) return;
     const o = f.objects.find((x) => scene.objects[x.index] && scene.objects[x.index].name === objectName);
     if (!o) return;
@@ -196,6 +200,7 @@ window.rp = {
   get plot() { return plot; },
   get frozen() { return frozen; },
   get cursor() { return cursor; },
+  get lastFrame() { return lastFrame; },
 };
 
 // ---- Log variables: plots of any column of the program's log file, and start/stop logging ----
@@ -351,4 +356,126 @@ Object.defineProperties(window.rp, Object.getOwnPropertyDescriptors({
   get logSamples() { return logSamples; },
   get logSeries() { return logSeries; },
   get logData() { return logData; },
+}));
+
+// ---- The control program: start, stop, restart; save and load its control-program files; ----
+// ---- QMotor's log (variables, decimation, trigger) and its CSV download.                   ----
+const progEl = {
+  name: document.getElementById('prog-name'),
+  state: document.getElementById('prog-state'),
+  result: document.getElementById('prog-result'),
+  saveAs: document.getElementById('cfg-save-as'),
+  files: document.getElementById('cfg-files'),
+  folder: document.getElementById('cfg-folder'),
+  capVars: document.getElementById('cap-variables'),
+  capState: document.getElementById('cap-state'),
+  every: document.getElementById('cap-every'),
+  samplesIn: document.getElementById('cap-samples'),
+  trigColumn: document.getElementById('cap-trigger-column'),
+  trigEdge: document.getElementById('cap-trigger-edge'),
+  trigLevel: document.getElementById('cap-trigger-level'),
+};
+let progStatus = null; // the last status of the chosen object's program
+let progResult = null; // { ok, text } of the last request
+let lastReply = null; // the last reply to a button (with the program's status at that moment)
+let capVariablesOf = ''; // the object whose variables the check boxes list
+
+function showResult(ok, text) {
+  progResult = { ok, text };
+  progEl.result.textContent = text;
+  progEl.result.className = ok ? 'ok' : 'bad';
+}
+
+function showProgramStatus(s) {
+  progStatus = s;
+  if (!s.hasProgram) {
+    progEl.name.textContent = `${s.object}: no control program`;
+    progEl.state.textContent = '';
+    return;
+  }
+  progEl.name.textContent = `${s.program} (${s.rate} Hz)`;
+  progEl.state.textContent = s.running ? `running, ${s.cycles} cycles` : `stopped after ${s.cycles} cycles`;
+  progEl.state.className = s.running ? 'on' : 'off';
+  progEl.folder.textContent = s.folder ? `in ${s.folder}` : 'no rp.cfg section: no folder';
+  progEl.folder.title = s.configFile ? `qmotorConfig ${s.configFile}` : '';
+  const chosenFile = progEl.files.value;
+  if (progEl.files.options.length !== s.files.length || s.files.some((f, i) => progEl.files.options[i].value !== f)) {
+    progEl.files.replaceChildren(...s.files.map((f) => new Option(f, f)));
+    if (s.files.includes(chosenFile)) progEl.files.value = chosenFile;
+  }
+  if (capVariablesOf !== s.object) {
+    capVariablesOf = s.object;
+    progEl.capVars.replaceChildren(...s.variables.map((v) => {
+      const label = document.createElement('label');
+      const box = document.createElement('input');
+      box.type = 'checkbox';
+      box.dataset.variable = v.name;
+      label.append(box, ` ${v.name}${v.unit ? ` [${v.unit}]` : ''}`);
+      return label;
+    }));
+    const columns = s.variables.flatMap((v) => (v.vector ? [...Array(v.size).keys()].map((i) => `${v.name}[${i}]`) : [v.name]));
+    progEl.trigColumn.replaceChildren(new Option('none (at once)', ''), ...columns.map((c) => new Option(c, c)));
+  }
+  const c = s.capture;
+  if (!c.armed) progEl.capState.textContent = 'not armed';
+  else if (!c.triggered && !c.trigger) progEl.capState.textContent = 'armed: from the next cycle';
+  else if (!c.triggered) progEl.capState.textContent = `armed: waiting for ${c.trigger.column} ${c.trigger.edge} through ${c.trigger.level}`;
+  else progEl.capState.textContent = `${c.rows} of ${c.capacity} rows${c.rows === c.capacity ? ' (full)' : ''}, every ${c.every} cycles, from t = ${c.triggerTime.toFixed(3)} s`;
+  progEl.capState.className = c.armed && c.triggered && c.rows < c.capacity ? 'on' : 'off';
+}
+
+// Sends a QMotor request about the chosen object; shows the message or the refusal with its reason.
+async function qmotor(action, fields = {}, quiet = false) {
+  if (!objectName) return null;
+  try {
+    const r = await conn.request({ type: 'qmotor', object: objectName, action, ...fields });
+    const reply = JSON.parse(r.reply);
+    if (reply.status) showProgramStatus(reply.status);
+    if (!quiet) lastReply = reply;
+    if (!quiet && reply.message) showResult(true, reply.message);
+    return reply;
+  } catch (e) {
+    if (!quiet) showResult(false, `${action}: ${e.message}`);
+    return null;
+  }
+}
+
+document.getElementById('prog-start').addEventListener('click', () => qmotor('start'));
+document.getElementById('prog-stop').addEventListener('click', () => qmotor('stop'));
+document.getElementById('prog-restart').addEventListener('click', () => qmotor('restart'));
+document.getElementById('cfg-save').addEventListener('click', () => {
+  const file = progEl.saveAs.value.trim();
+  qmotor('save', file ? { file } : {});
+});
+document.getElementById('cfg-load').addEventListener('click', () => {
+  if (!progEl.files.value) return showResult(false, 'load: no control-program file in the folder');
+  qmotor('load', { file: progEl.files.value });
+});
+document.getElementById('cap-arm').addEventListener('click', () => {
+  const variables = [...progEl.capVars.querySelectorAll('input:checked')].map((b) => b.dataset.variable);
+  // Numbers as typed: the server checks them (and names a bad one).
+  const fields = { variables, every: Number(progEl.every.value), samples: Number(progEl.samplesIn.value) };
+  fields.trigger = progEl.trigColumn.value
+    ? { column: progEl.trigColumn.value, edge: progEl.trigEdge.value, level: Number(progEl.trigLevel.value) }
+    : null;
+  qmotor('capture', fields);
+});
+document.getElementById('cap-download').addEventListener('click', async () => {
+  const reply = await qmotor('csv');
+  if (!reply) return;
+  const a = document.createElement('a');
+  a.download = reply.file;
+  a.href = URL.createObjectURL(new Blob([reply.csv], { type: 'text/csv' }));
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 60000);
+  showResult(true, `downloaded ${reply.rows} rows as ${reply.file}`);
+});
+select.addEventListener('change', () => qmotor('status', {}, true));
+// The program's state, twice a second.
+setInterval(() => conn.connected && qmotor('status', {}, true), 500);
+
+Object.defineProperties(window.rp, Object.getOwnPropertyDescriptors({
+  get program() { return progStatus; },
+  get result() { return progResult; },
+  get lastReply() { return lastReply; },
 }));

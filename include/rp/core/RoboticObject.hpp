@@ -271,6 +271,35 @@ class RoboticObject {
   std::vector<std::string> getThreadNames() const;
   /// Whether the additional threads have been started and not yet stopped. Real-time safe: yes.
   bool areThreadsRunning() const noexcept;
+  /// QMotor's Stop (paper section 3.8): stops the object's control program, which can be started
+  /// again (startControlProgram()). The default stops the loop after its current cycle; a class
+  /// whose loop drives hardware brings it to a safe state first (a manipulator: a damped hold until
+  /// the arm is at rest, then the power off and the brakes on, where it came to rest).
+  /// @return what was done, for the page
+  /// @throws std::invalid_argument if the object runs no control program
+  /// @throws std::logic_error if the program is not running
+  /// Real-time safe: no.
+  virtual std::string stopControlProgram();
+  /// QMotor's Start: starts the object's control program again after stopControlProgram(). A
+  /// manipulator's loop starts holding the arm where it is (bumpless), powered as before the stop.
+  /// @return what was done
+  /// @throws std::invalid_argument if the object runs no control program
+  /// @throws std::logic_error saying why not: it runs already, the system or the object is
+  ///         shutting down, or the object has an error
+  /// Real-time safe: no.
+  virtual std::string startControlProgram();
+  /// QMotor's Restart: stopControlProgram() if the program runs, then startControlProgram().
+  /// @return what was done
+  /// @throws as those two
+  /// Real-time safe: no.
+  std::string restartControlProgram();
+  /// The control-program file (`qmotorConfig`) of the object's rp.cfg section, or "" if it has none.
+  /// Real-time safe: no.
+  std::string getQMotorConfigFile() const;
+  /// The folder QMotor saves and loads the object's control-program files in: the folder of its
+  /// `qmotorConfig` file, else the folder of the rp.cfg that configures it, else "" (none).
+  /// Real-time safe: no.
+  std::string getQMotorConfigFolder() const;
   /// Called first by stopControlLoop() while the loop still runs: a class whose loop drives
   /// hardware waits here until it is safe to stop (a manipulator holds its arm until at rest and
   /// switches the power off). The default does nothing.
@@ -308,6 +337,14 @@ class RoboticObject {
   /// @}
 
  protected:
+  /// Applies the `qmotorConfig` file of the object's rp.cfg section to its control program, once
+  /// (later calls do nothing); startControlLoop() calls it before the loop starts, so it works for
+  /// every class that runs a control program (a class may call it earlier in its constructor).
+  /// @throws ConfigError naming FILE:LINE for a bad line of the file (an unknown name, a wrong
+  ///         count, a value out of range), or the rp.cfg line of `qmotorConfig` if the object runs
+  ///         no control program (the file would be ignored)
+  /// Real-time safe: no.
+  void applyQMotorConfigFile();
   /// Marks the shutdown complete (for classes overriding startShutdown()). Real-time safe: yes.
   void setShutdownComplete() noexcept;
   /// For the actions of a device's commands (addCommandWithResult()): returns `done` when the

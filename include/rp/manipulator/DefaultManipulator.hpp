@@ -174,6 +174,20 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   /// never cuts the power of a moving arm. Bounded: at most about 5 s.
   void beforeControlLoopStops() override { holdUntilSafe(); }
 
+  /// QMotor's Stop: a powered arm is held (damped, with gravity compensation) until it is at rest,
+  /// then the power goes off and the brakes on where it came to rest; then the loop stops. Unlike
+  /// a shutdown, the program can be started again (startControlProgram()).
+  /// @return what was done, with the joints where the arm was braked [deg]
+  /// @throws std::logic_error if the loop is not running
+  std::string stopControlProgram() override;
+  /// QMotor's Start: the loop starts holding the arm where it is (a bumpless hand-over: the servo
+  /// control starts afresh at the joints read in the first cycle), with the power on if it was on
+  /// at the stop; with a trajectory generator set the arm stays braked (its program powers it, as
+  /// for the Power On command).
+  /// @return what was done
+  /// @throws std::logic_error saying why not (see RoboticObject::startControlProgram())
+  std::string startControlProgram() override;
+
   /// Starts the damped hold (velocity damping plus gravity compensation, within the torque
   /// limits) until the arm is at rest, then switches the power off and engages the brakes. The
   /// servo loop goes on running (holding the outputs off) until the system shutdown stops it.

@@ -58,6 +58,32 @@ struct ParameterInfo {
   std::string description;  ///< one line for the tuning window
 };
 
+/// What QMotor's log records (ControlProgram::setLogCapture()): the chosen log variables, every
+/// `every`-th cycle, into a buffer of `samples` rows that fills once and stops, from the first
+/// cycle or from a trigger: the cycle in which `triggerColumn` crosses `triggerLevel`.
+struct LogCaptureSettings {
+  std::vector<std::string> variables;  ///< registered log variables (every value of each); empty: all
+  unsigned every = 1;                  ///< decimation: one row every `every` cycles, 1..kMaxLogEvery
+  std::size_t samples = 10000;         ///< rows kept; samples × (columns + 1) <= kMaxLogCaptureValues
+  std::string triggerColumn;           ///< `q[0]` (a vector's value) or `gain` (a scalar); empty: no trigger
+  double triggerLevel = 0;             ///< the level the trigger column crosses (finite)
+  bool triggerRising = true;           ///< true: from below to at or above the level; false: from above to at or below
+};
+
+/// The state of QMotor's log (ControlProgram::getLogCaptureStatus()).
+struct LogCaptureStatus {
+  bool armed = false;        ///< a capture is set (setLogCapture() since the last clearLogCapture())
+  bool triggered = false;    ///< recording: the trigger fired (at once without a trigger)
+  double triggerTime = 0;    ///< the program's clock time of the first row [s] (when triggered)
+  std::size_t rows = 0;      ///< rows recorded
+  std::size_t capacity = 0;  ///< rows it holds; full when rows == capacity
+  unsigned every = 1;        ///< decimation
+  std::vector<std::string> columns;  ///< CSV columns after `t`: `program.variable` or `program.vector[i]`
+  std::string triggerColumn;         ///< as set ("" for none)
+  double triggerLevel = 0;           ///< as set
+  bool triggerRising = true;         ///< as set
+};
+
 /// A periodic control loop in its own thread (QMotor's ControlProgram).
 ///
 /// Derive from it and implement control(); register log variables and parameters in the
@@ -184,6 +210,32 @@ class ControlProgram {
   /// @param[in] samples  capacity, 2 .. kMaxLogBufferSize
   /// @throws std::invalid_argument if out of range; std::logic_error if running
   void setLogBufferSize(std::size_t samples);
+  /// Largest decimation setLogEvery() (file log) and setLogCapture() accept [cycles].
+  static constexpr unsigned kMaxLogEvery = 1000000;
+  /// Largest QMotor log setLogCapture() accepts: rows × (columns + 1) values.
+  static constexpr std::size_t kMaxLogCaptureValues = 1000000;
+  /// Sets up QMotor's log (paper section 3.8: logging modes), from any thread, running or not:
+  /// the chosen variables every `every`-th cycle into a preallocated buffer, from the first
+  /// cycle or from the cycle in which the trigger column crosses its level (rising: the previous
+  /// value below the level and this one at or above it; falling: the reverse), until the buffer
+  /// is full. Replaces the previous capture and its rows. The loop takes the samples after
+  /// control() without allocating or locking; this call allocates the buffer and waits for the
+  /// loop to let go of the previous one (at most one cycle).
+  /// @param[in] settings  what to record
+  /// @throws std::invalid_argument naming the field for an unknown variable or trigger column, a
+  ///         decimation outside 1..kMaxLogEvery, no rows, too many values, or a level that is not finite
+  /// Real-time safe: no.
+  void setLogCapture(const LogCaptureSettings& settings);
+  /// Removes QMotor's log (and its rows). Real-time safe: no.
+  void clearLogCapture();
+  /// The state of QMotor's log. Real-time safe: no.
+  LogCaptureStatus getLogCaptureStatus() const;
+  /// The rows of QMotor's log as CSV in the log file's format (LogWriter): a header
+  /// `t,program.variable,program.vector[0],...`, then one row per sample, values as the shortest
+  /// text that reads back to the same double.
+  /// @throws std::logic_error if no capture is set
+  /// Real-time safe: no.
+  std::string getLogCaptureCsv() const;
   /// Sends this program's samples to `writer` (default: the platform's `-log` writer, if any).
   /// @param[in] writer  log writer that outlives the run, or nullptr for none
   void setLogWriter(LogWriter* writer);
@@ -254,9 +306,13 @@ class ControlProgram {
 
   /// Applies a control-program file: `name v1 v2 ...` sets parameter `name`; `rate HZ`,
   /// `priority P`, `logEvery N`, `logBufferSize N` and `log var1 var2 ...` (variables to log;
-  /// default all) set the program's settings.
+  /// default all) set the program's settings. The whole file is checked before anything is
+  /// applied: a bad file changes nothing. While the program runs the settings cannot change (a
+  /// file that gives their current values, as saveQMotorConfig() writes them, is accepted) and
+  /// the parameters take effect at the start of the next cycle.
   /// @param[in] file  parsed file
-  /// @throws ConfigError naming the file and line for an unknown name, a wrong count or a value out of range
+  /// @throws ConfigError naming the file and line for an unknown name, a wrong count, a value out
+  ///         of range, or a setting that would change while running
   void applyQMotorConfig(const ParameterFile& file);
   /// Writes the current parameters and log settings in the same format.
   /// @param[in] fileName  path to write
