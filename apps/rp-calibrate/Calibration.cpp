@@ -135,11 +135,12 @@ Eigen::MatrixXd baseRegressorRows(const ManipulatorModel& model, const std::vect
   return out;
 }
 
-Estimate estimate(double value, double se, double nominal) {
+Estimate estimate(const LeastSquares& ls, Eigen::Index k, double nominal) {
   Estimate e;
-  e.value = value;
-  e.stdError = se;
+  e.value = ls.x(k);
+  e.stdError = ls.se(k);
   e.nominal = nominal;
+  e.resolution = e.stdError * std::sqrt(static_cast<double>(ls.residual.size()));
   return e;
 }
 
@@ -362,6 +363,7 @@ Result fit(const ManipulatorModel& model, const std::vector<Sample>& samples, co
   result.offset.assign(static_cast<std::size_t>(n), Estimate());
   result.offsetObservable.assign(static_cast<std::size_t>(n), false);
   result.offsetSeparable.assign(static_cast<std::size_t>(n), false);
+  result.offsetSensitivity.assign(static_cast<std::size_t>(n), 0.0);
   Eigen::VectorXd g;
   Eigen::MatrixXd J;
   if (fitOffsets) {
@@ -387,19 +389,25 @@ Result fit(const ManipulatorModel& model, const std::vector<Sample>& samples, co
       A.leftCols(F.cols()) = F;
       for (Eigen::Index c = 0; c < m; ++c) A.col(F.cols() + c) = J.col(observable[static_cast<std::size_t>(c)]);
       last = solve(A, y - g);
-      double step = 0;
+      // Converged when every step is below 1e-10 rad or a thousandth of its standard error (a
+      // poorly observable offset keeps moving by rounding in its finite differences otherwise).
+      bool converged = true;
       for (Eigen::Index c = 0; c < m; ++c) {
         const double d = last.x(F.cols() + c);
         delta(observable[static_cast<std::size_t>(c)]) += d;
-        step = std::max(step, std::abs(d));
+        if (std::abs(d) > std::max(1e-10, 1e-3 * last.se(F.cols() + c))) converged = false;
       }
       result.offsetIterations = it + 1;
       gravityRows(model, rows, samples, delta, g, &J);
-      if (step < 1e-10) break;
+      if (converged) break;
     }
+    const double count = static_cast<double>(y.size());
+    if (m > 0) result.offsetResidualRms = std::sqrt(last.residual.squaredNorm() / count);
     for (Eigen::Index c = 0; c < m; ++c) {
       const auto j = static_cast<std::size_t>(observable[static_cast<std::size_t>(c)]);
-      result.offset[j] = estimate(delta(static_cast<Eigen::Index>(j)), last.se(F.cols() + c), 0);
+      result.offset[j] = estimate(last, F.cols() + c, 0);
+      result.offset[j].value = delta(static_cast<Eigen::Index>(j));
+      result.offsetSensitivity[j] = proj.col(static_cast<Eigen::Index>(j)).norm() / std::sqrt(count);
     }
     // Separable from the gravity parameters: the offset's column is not in the span of the base
     // regressor and the friction columns.
@@ -422,14 +430,14 @@ Result fit(const ManipulatorModel& model, const std::vector<Sample>& samples, co
                              std::to_string(A.cols()) + "): add poses");
   result.residualRms = std::sqrt(ls.residual.squaredNorm() / static_cast<double>(ls.residual.size()));
   const Eigen::VectorXd nominal = base.project(gravityParameters(model));
-  for (Eigen::Index b = 0; b < Yb.cols(); ++b) result.gravity.push_back(estimate(ls.x(b), ls.se(b), nominal(b)));
+  for (Eigen::Index b = 0; b < Yb.cols(); ++b) result.gravity.push_back(estimate(ls, b, nominal(b)));
   for (int i = 0; i < n; ++i) {
     double fv = 0, fc = 0, fa = 0;
     modelFriction(model, i, fv, fc, fa);
     const Eigen::Index c = Yb.cols() + 3 * i;
-    result.viscous.push_back(estimate(ls.x(c), ls.se(c), fv));
-    result.coulomb.push_back(estimate(ls.x(c + 1), ls.se(c + 1), fc));
-    result.asymmetry.push_back(estimate(ls.x(c + 2), ls.se(c + 2), fa));
+    result.viscous.push_back(estimate(ls, c, fv));
+    result.coulomb.push_back(estimate(ls, c + 1, fc));
+    result.asymmetry.push_back(estimate(ls, c + 2, fa));
   }
   return result;
 }

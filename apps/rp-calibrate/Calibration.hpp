@@ -124,6 +124,10 @@ struct Estimate {
   double value = 0;    ///< identified
   double stdError = 0; ///< standard error (from the residual variance and \f$(A^T A)^{-1}\f$)
   double nominal = 0;  ///< the model's value
+  /// The largest error a systematic (unmodelled, not random) torque error of the fit's residual
+  /// size can cause: by Cauchy-Schwarz \f$\|e\| \sqrt{[(A^T A)^{-1}]_{kk}}\f$ with
+  /// \f$\|e\| = \sqrt{N}\f$ times the residual's rms, i.e. \f$\sqrt{N}\f$ standard errors.
+  double resolution = 0;
 };
 
 /// Everything rp-calibrate identifies.
@@ -131,6 +135,10 @@ struct Result {
   std::vector<Estimate> offset;           ///< encoder offsets per joint (reading - true) [rad or m]
   std::vector<bool> offsetObservable;     ///< false: the gravity torque does not depend on it (left at 0)
   std::vector<bool> offsetSeparable;      ///< false: it equals a change of the base parameters (found with the model's masses)
+  /// How much the gravity torque changes per radian of each offset (rms over the rows, the
+  /// friction's share taken out) [N m/rad]; 0 when not observable.
+  std::vector<double> offsetSensitivity;
+  double offsetResidualRms = 0;           ///< torque residual of the offset fit [N m]
   BaseParameters baseParameters;          ///< the partition the gravity fit used
   std::vector<Estimate> gravity;          ///< base gravity parameters, in the order of baseParameters.base
   std::vector<Estimate> viscous;          ///< F_v per joint [N m s/rad]

@@ -229,7 +229,14 @@ class PlanRunner : public TrajectoryGenerator {
 double toUser(const ManipulatorModel& model, int j, double v) { return model.isPrismatic(j) ? v * 1e3 : v * 180 / M_PI; }
 const char* userUnit(const ManipulatorModel& model, int j) { return model.isPrismatic(j) ? "mm" : "deg"; }
 
-json estimateJson(const Estimate& e) { return json{{"value", e.value}, {"stdError", e.stdError}, {"nominal", e.nominal}}; }
+json estimateJson(const Estimate& e) {
+  return json{{"value", e.value}, {"stdError", e.stdError}, {"resolution", e.resolution}, {"nominal", e.nominal}};
+}
+
+// An offset the data resolves only to more than 0.1 degree (or 2 mm) is reported, not written.
+bool poorlyObservable(const ManipulatorModel& model, int j, double resolution) {
+  return resolution > (model.isPrismatic(j) ? 2e-3 : 0.1 * M_PI / 180);
+}
 
 json resultJson(const Manipulator& arm, const Result& r, std::size_t samples, bool offsets) {
   const ManipulatorModel& model = arm.getModel();
@@ -242,6 +249,8 @@ json resultJson(const Manipulator& arm, const Result& r, std::size_t samples, bo
   out["rowsPerJoint"] = r.rowsPerJoint;
   out["residualRms"] = r.residualRms;
   out["offsetsFitted"] = offsets;
+  out["offsetResidualRms"] = r.offsetResidualRms;
+  out["offsetIterations"] = r.offsetIterations;
   json off = json::array(), fr = json::array();
   for (int j = 0; j < n; ++j) {
     const auto i = static_cast<std::size_t>(j);
@@ -249,6 +258,7 @@ json resultJson(const Manipulator& arm, const Result& r, std::size_t samples, bo
     o["joint"] = j + 1;
     o["observable"] = r.offsetObservable[i];
     o["separableFromGravity"] = r.offsetSeparable[i];
+    o["sensitivity"] = r.offsetSensitivity[i];
     off.push_back(o);
     fr.push_back(json{{"joint", j + 1},
                       {"viscous", estimateJson(r.viscous[i])},
@@ -277,18 +287,29 @@ void printTable(const Manipulator& arm, const Result& r, std::size_t samples, bo
   std::printf("rp-calibrate: %s (%s, %d joints): %zu samples, torque residual %.4g N m rms\n\n", arm.getName().c_str(),
               arm.getClassName().c_str(), n, samples, r.residualRms);
   std::printf("encoder offsets (reading - true angle)%s\n", offsets ? "" : ": not fitted (--offsets off)");
+  bool separable = true;
   if (offsets) {
-    std::printf("  joint  offset      std.err     \n");
+    std::printf("  joint  offset        std.err    resolution  sensitivity [N m/rad]\n");
     for (int j = 0; j < n; ++j) {
       const auto i = static_cast<std::size_t>(j);
       if (!r.offsetObservable[i]) {
         std::printf("  %5d  not observable: the gravity torque does not depend on it (left at 0)\n", j + 1);
         continue;
       }
-      std::printf("  %5d  %+9.4f %s  %8.4f %s%s\n", j + 1, toUser(model, j, r.offset[i].value), userUnit(model, j),
-                  toUser(model, j, r.offset[i].stdError), userUnit(model, j),
-                  r.offsetSeparable[i] ? "" : "  (found with the model's masses: equals a change of the base parameters)");
+      std::printf("  %5d  %+9.4f %s  %8.4f %s  %8.4f %s  %9.4g%s\n", j + 1, toUser(model, j, r.offset[i].value),
+                  userUnit(model, j), toUser(model, j, r.offset[i].stdError), userUnit(model, j),
+                  toUser(model, j, r.offset[i].resolution), userUnit(model, j), r.offsetSensitivity[i],
+                  poorlyObservable(model, j, r.offset[i].resolution) ? "  poorly observable" : "");
+      if (!r.offsetSeparable[i]) separable = false;
     }
+  }
+  if (offsets) {
+    std::printf("  (resolution: the largest error a systematic torque error of the fit's residual, %.3g N m rms,\n"
+                "  can cause; sensitivity: the gravity torque's change per radian, rms)\n",
+                r.offsetResidualRms);
+    if (!separable)
+      std::printf("  The offsets are found with the model's masses: an offset error and a mass error change the gravity\n"
+                  "  torque alike (see docs/calibration.md); with wrong masses, fit the offsets with a known load.\n");
   }
   std::printf("\nfriction (joint side)\n");
   std::printf("  joint  viscous [N m s/rad]            Coulomb [N m]                   asymmetry [N m]\n");
@@ -336,6 +357,11 @@ void writeSettings(const std::string& file, const Manipulator& arm, const Result
         out << "#   joint " << j + 1 << ": not observable from gravity\n";
         continue;
       }
+      if (poorlyObservable(model, j, r.offset[i].resolution)) {
+        out << "#   joint " << j + 1 << ": poorly observable (resolution " << toUser(model, j, r.offset[i].resolution) << " "
+            << userUnit(model, j) << "): not used\n";
+        continue;
+      }
       out << "#   joint " << j + 1 << ": reads " << toUser(model, j, r.offset[i].value) << " " << userUnit(model, j)
           << " too much: subtract " << std::lround(r.offset[i].value * counts) << " counts\n";
     }
@@ -369,7 +395,9 @@ void writeSettings(const std::string& file, const Manipulator& arm, const Result
     out << "simEncoderOffset";
     for (int j = 0; j < n; ++j) {
       char buf[32];
-      std::snprintf(buf, sizeof buf, " %.5g", std::clamp(toUser(model, j, r.offset[static_cast<std::size_t>(j)].value), -10.0, 10.0));
+      const Estimate& e = r.offset[static_cast<std::size_t>(j)];
+      const double value = poorlyObservable(model, j, e.resolution) ? 0.0 : toUser(model, j, e.value);
+      std::snprintf(buf, sizeof buf, " %.5g", std::clamp(value, -10.0, 10.0));
       out << buf;
     }
     out << "   # " << userUnit(model, 0) << "\n";
