@@ -270,13 +270,31 @@ std::vector<PlanSegment> makePlan(const ManipulatorModel& model, const PlanOptio
   for (double v : options.sweepSpeeds)
     if (!(v > 0)) throw std::invalid_argument("makePlan: sweep speeds must be positive");
   const int n = model.getNumberOfJoints();
-  const JointVector fast = 0.5 * model.getVelocityLimit();
+  const JointVector fast = 0.3 * model.getVelocityLimit();  // moves between the logged motions
   JointVector lo(n), hi(n), middle(n);
   for (int j = 0; j < n; ++j) {
     planningRange(model, j, lo(j), hi(j));
     middle(j) = 0.5 * (lo(j) + hi(j));
   }
+  // The servo holds the arm only where gravity leaves it torque to move: every point of every
+  // motion keeps the gravity torque within 60 % of each joint's torque limit (checked at 21
+  // points along the straight joint-space path each synchronised motion follows).
+  ManipulatorData data(model);
+  JointVector g(n);
+  auto holdable = [&](const JointVector& q) {
+    gravityTorque(model, data, q, g);
+    for (int j = 0; j < n; ++j)
+      if (std::abs(g(j)) > 0.6 * model.getTorqueLimit()(j)) return false;
+    return true;
+  };
+  bool started = false;  // the first motion starts where the arm is, held already: only its end is checked
+  auto pathHoldable = [&](const JointVector& a, const JointVector& b) {
+    for (int k = started ? 0 : 20; k <= 20; ++k)
+      if (!holdable(a + (b - a) * (k / 20.0))) return false;
+    return true;
+  };
   std::vector<PlanSegment> plan;
+  JointVector at = model.getHomePosition();
   auto add = [&](const JointVector& target, const JointVector& vmax, bool log, const std::string& what) {
     PlanSegment s;
     s.target = target;
@@ -284,30 +302,50 @@ std::vector<PlanSegment> makePlan(const ManipulatorModel& model, const PlanOptio
     s.log = log;
     s.what = what;
     plan.push_back(std::move(s));
+    at = target;
+    started = true;
   };
+  const JointVector cap = 0.5 * model.getVelocityLimit();  // logged motions
   std::mt19937 rng(options.seed);
   JointVector passSpeed(n);
-  for (int j = 0; j < n; ++j) passSpeed(j) = std::min(options.passSpeed, fast(j));
+  for (int j = 0; j < n; ++j) passSpeed(j) = std::min(options.passSpeed, cap(j));
+  const JointVector a = JointVector::Constant(n, options.passAmplitude);
   for (int k = 1; k <= options.poses; ++k) {
     JointVector pose(n);
-    for (int j = 0; j < n; ++j) {
-      const double margin = 0.15 * (hi(j) - lo(j));
-      pose(j) = std::uniform_real_distribution<double>(lo(j) + margin, hi(j) - margin)(rng);
+    for (int attempt = 0;; ++attempt) {
+      if (attempt == 10000)
+        throw std::runtime_error("no pose found that the arm can hold within 60 % of its torque limits");
+      for (int j = 0; j < n; ++j) {
+        const double margin = 0.15 * (hi(j) - lo(j));
+        pose(j) = std::uniform_real_distribution<double>(lo(j) + margin, hi(j) - margin)(rng);
+      }
+      if (pathHoldable(at, pose - a) && pathHoldable(pose - a, pose + a)) break;
     }
-    const JointVector a = JointVector::Constant(n, options.passAmplitude);
     add(pose - a, fast, false, "to pose " + std::to_string(k));
     add(pose + a, passSpeed, true, "pose " + std::to_string(k) + " +");
     add(pose - a, passSpeed, true, "pose " + std::to_string(k) + " -");
   }
   for (int j = 0; j < n; ++j) {
+    // Each joint sweeps about the middle of its range, the others in the middle of theirs, or
+    // else at the home position; the range shrinks until the arm can hold every point.
     const double margin = 0.1 * (hi(j) - lo(j));
-    JointVector from = middle, to = middle;
-    from(j) = std::max(lo(j) + margin, middle(j) - options.sweepRange);
-    to(j) = std::min(hi(j) - margin, middle(j) + options.sweepRange);
+    JointVector from, to;
+    bool found = false;
+    for (const JointVector* base : {static_cast<const JointVector*>(&middle), &model.getHomePosition()}) {
+      for (double range = options.sweepRange; range > 0.05 && !found; range *= 0.8) {
+        from = to = *base;
+        from(j) = std::max(lo(j) + margin, middle(j) - range);
+        to(j) = std::min(hi(j) - margin, middle(j) + range);
+        found = pathHoldable(at, from) && pathHoldable(from, to);
+      }
+      if (found) break;
+    }
+    if (!found)
+      throw std::runtime_error("joint " + std::to_string(j + 1) + ": no sweep the arm can hold within 60 % of its torque limits");
     add(from, fast, false, "to joint " + std::to_string(j + 1) + " sweeps");
     for (double v : options.sweepSpeeds) {
       JointVector vmax = fast;
-      vmax(j) = std::min(v, fast(j));
+      vmax(j) = std::min(v, cap(j));
       char speed[32];
       std::snprintf(speed, sizeof speed, "%.3g", vmax(j));
       add(to, vmax, true, "joint " + std::to_string(j + 1) + " sweep " + speed + " +");

@@ -111,12 +111,17 @@ struct PlanSegment {
 
 /// The excitation plan: move to each of `options.poses` random poses (kept 15 % of each joint's
 /// range inside its limits) and pass through it slowly on all joints, up and down; then for each
-/// joint, at the middle of the joint ranges, constant-velocity sweeps at each speed of
-/// `options.sweepSpeeds`, up and down (kept 10 % of the range inside the limits).
+/// joint, at the middle of the joint ranges (or else at the home position), constant-velocity
+/// sweeps at each speed of `options.sweepSpeeds`, up and down (kept 10 % of the range inside the
+/// limits). Every motion keeps the model's gravity torque within 60 % of each joint's torque
+/// limit along its path (the first only at its end: it starts where the arm is held; poses are
+/// drawn again, sweeps shortened). Transfers between the logged motions run at 0.3 of the
+/// velocity limits.
 /// @param[in] model    the manipulator model (limits)
 /// @param[in] options  sizes and speeds
 /// @return the segments in order; the first starts where the arm is
 /// @throws std::invalid_argument on non-positive sizes or speeds
+/// @throws std::runtime_error when no pose or sweep keeps within the torque limits
 std::vector<PlanSegment> makePlan(const ManipulatorModel& model, const PlanOptions& options);
 
 /// An identified value with its standard error and the model's (nominal) value.

@@ -143,7 +143,7 @@ class PlanRunner : public TrajectoryGenerator {
     const ManipulatorModel& model = arm.getModel();
     const int n = model.getNumberOfJoints();
     JointVector start = arm.getJointPosition();
-    const JointVector amax = 0.5 * model.getAccelerationLimit(), jmax = 0.5 * model.getJerkLimit();
+    const JointVector amax = 0.25 * model.getAccelerationLimit(), jmax = 0.25 * model.getJerkLimit();
     double logged = 0;
     for (const PlanSegment& s : plan) {
       motions_.emplace_back(start, s.target, s.vmax, amax, jmax, Synchronization::Time);

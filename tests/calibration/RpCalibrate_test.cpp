@@ -215,6 +215,28 @@ TEST(RpCalibrate, RecoversThePumasGravityParametersAfterAMassChange) {
     EXPECT_NE(std::find(unidentifiable.begin(), unidentifiable.end(), name), unidentifiable.end()) << name;
 }
 
+// A WAM 7 (no friction in its model): the offsets of joints 2-4 within 0.005 degrees; those of
+// the wrist are reported as poorly observable, joint 1's as not observable; the gravity
+// parameters are the model's.
+TEST(RpCalibrate, RecoversTheWam7sEncoderOffsets) {
+  const double offsetDeg[7] = {0.3, -0.3, 0.25, 0.4, -0.3, 0.3, 0.2};
+  const Outcome r = run("--json",
+                        "[wam]\nclass WAM\nlinks 7\nsimEncoderOffset 0.3 -0.3 0.25 0.4 -0.3 0.3 0.2\n"
+                        "simCountsPerRadian 100000\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json out = nlohmann::json::parse(r.out);
+  const auto& offsets = out.at("offsets");
+  EXPECT_FALSE(offsets.at(0).at("observable").get<bool>()) << "a vertical first joint";
+  for (int j = 1; j < 4; ++j)
+    expectRecovered(offsets.at(static_cast<std::size_t>(j)), offsetDeg[j] * kDeg, 0.005 * kDeg,
+                    "offset of joint " + std::to_string(j + 1));
+  for (int j = 4; j < 7; ++j)
+    EXPECT_GT(offsets.at(static_cast<std::size_t>(j)).at("resolution").get<double>(), 0.1 * kDeg)
+        << "joint " << j + 1 << ": the wrist's small moments leave its offset poorly observable";
+  for (const auto& b : out.at("gravity").at("base"))
+    expectRecovered(b, b.at("nominal").get<double>(), 1e-3, b.at("expression").get<std::string>());
+}
+
 TEST(RpCalibrate, PrintsATableByDefault) {
   const Outcome r = run("--poses 4 --sweep-speeds 0.3,0.8", "[arm]\nclass Puma560\nsimEncoderOffset 0 0.5 0 0 0 0\n");
   ASSERT_EQ(r.status, 0) << r.err;
