@@ -143,12 +143,21 @@ TEST(BaseParameters, Puma560VerticalFirstJointHasNoGravityParameters) {
   }
 }
 
-TEST(Plan, StaysWithinTheJointLimits) {
+TEST(Plan, StaysWithinTheJointAndTorqueLimits) {
   for (const ManipulatorModel* model : std::initializer_list<const ManipulatorModel*>{new Puma560Model, new WAM7Model}) {
     const std::vector<PlanSegment> plan = makePlan(*model, PlanOptions());
     std::size_t logged = 0;
-    for (const PlanSegment& s : plan) {
+    ManipulatorData data(*model);
+    JointVector g(model->getNumberOfJoints());
+    for (std::size_t k = 0; k < plan.size(); ++k) {
+      const PlanSegment& s = plan[k];
       logged += s.log;
+      // The arm can hold every point of every motion (the first one's end; the others' paths).
+      for (int step = k == 0 ? 10 : 0; step <= 10; ++step) {
+        gravityTorque(*model, data, k == 0 ? s.target : JointVector(plan[k - 1].target + (s.target - plan[k - 1].target) * (step / 10.0)), g);
+        for (int j = 0; j < model->getNumberOfJoints(); ++j)
+          EXPECT_LE(std::abs(g(j)), 0.6 * model->getTorqueLimit()(j) + 1e-9) << s.what << " joint " << j + 1;
+      }
       for (int j = 0; j < model->getNumberOfJoints(); ++j) {
         EXPECT_GT(s.target(j), model->getPositionMin()(j)) << s.what;
         EXPECT_LT(s.target(j), model->getPositionMax()(j)) << s.what;
