@@ -124,7 +124,7 @@ TEST(RpCalibrate, RecoversThePumasEncoderOffsetsAndFriction) {
   EXPECT_EQ(out.at("arm"), "puma");
   // The torques paired with the state in the middle of the servo step they acted over, less the
   // inertial torque of the step's mean acceleration, leave 2.7e-3 N m rms (the integration error
-  // above); paired with the state at the step's start and no inertial torque they left 1.1e-2.
+  // above); paired with the state at the step's start and no inertial torque they left 7.7e-3.
   EXPECT_LT(out.at("residualRms").get<double>(), 0.005) << "N m";
   const auto& offsets = out.at("offsets");
   // A vertical first joint turns nothing against gravity; the last link's centre of mass lies on
