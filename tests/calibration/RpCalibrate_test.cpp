@@ -25,7 +25,6 @@
 // resolution cannot hide a wrong value.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -36,23 +35,15 @@
 #include <string>
 
 #include "Calibration.hpp"
+#include "RunProgram.hpp"
 #include "rp/manipulator/ManipulatorSimulation.hpp"
 #include "rp/model/Model.hpp"
 
 namespace rp::calibration {
 namespace {
 
-struct Outcome {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::Outcome;
+using test::slurp;
 
 std::string tempPath(const std::string& name) { return ::testing::TempDir() + "rp_calibrate_" + std::to_string(::getpid()) + "_" + name; }
 
@@ -63,13 +54,7 @@ Outcome run(const std::string& args, const std::string& config = "") {
     std::ofstream(base + ".cfg") << config;
     command += " -config " + base + ".cfg";
   }
-  command += " " + args + " >" + base + ".out 2>" + base + ".err";
-  const int raw = std::system(command.c_str());
-  Outcome r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = slurp(base + ".out");
-  r.err = slurp(base + ".err");
-  return r;
+  return test::runProgram(command + " " + args, base);
 }
 
 constexpr double kDeg = M_PI / 180;
