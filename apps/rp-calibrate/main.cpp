@@ -226,6 +226,11 @@ class PlanRunner : public TrajectoryGenerator {
   bool started_ = false, cruising_ = false, pending_ = false;
 };
 
+const char* kSettingsNote =
+    "rp.cfg: the controller's model has no setting for encoder offsets, friction or gravity parameters (re-zero\n"
+    "the encoders; the servo's compensation uses the built-in model); --write FILE writes the counts to subtract\n"
+    "and the settings of a simulated plant that matches the arm (simFrictionScale, simEncoderOffset).";
+
 double toUser(const ManipulatorModel& model, int j, double v) { return model.isPrismatic(j) ? v * 1e3 : v * 180 / M_PI; }
 const char* userUnit(const ManipulatorModel& model, int j) { return model.isPrismatic(j) ? "mm" : "deg"; }
 
@@ -278,6 +283,7 @@ json resultJson(const Manipulator& arm, const Result& r, std::size_t samples, bo
   for (int d : bp.dependent) dependent.push_back(gravityParameterName(d));
   for (int u : bp.unidentifiable) unidentifiable.push_back(gravityParameterName(u));
   out["gravity"] = json{{"base", base}, {"dependent", dependent}, {"unidentifiable", unidentifiable}};
+  out["settingsNote"] = kSettingsNote;
   return out;
 }
 
@@ -334,6 +340,7 @@ void printTable(const Manipulator& arm, const Result& r, std::size_t samples, bo
   };
   std::printf("not identifiable (no effect on the gravity torque):%s\n", list(bp.unidentifiable).c_str());
   std::printf("identifiable only in the combinations above:%s\n", list(bp.dependent).c_str());
+  std::printf("\n%s\n", kSettingsNote);
 }
 
 // The rp.cfg settings the library reads that can take the result, with a comment for the rest.

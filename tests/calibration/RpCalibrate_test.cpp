@@ -231,6 +231,8 @@ TEST(RpCalibrate, PrintsATableByDefault) {
   EXPECT_NE(r.out.find("rp-calibrate: arm (Puma560, 6 joints)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("      1  not observable"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("not identifiable (no effect on the gravity torque): m1 mcx1 mcy1 mcz1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("rp.cfg: the controller's model has no setting for encoder offsets, friction or gravity"),
+            std::string::npos) << r.out;
 }
 
 TEST(RpCalibrate, BadArgumentsExitWith2AndNameTheArgument) {
