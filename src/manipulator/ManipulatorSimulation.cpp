@@ -115,6 +115,7 @@ void ManipulatorSimulation::init() {
   A_.setZero(n, n);
   L_.setZero(n, n);
   brakeTorque_ = model_.getTorqueLimit();
+  encoderOffset_.setZero(n);
   for (int i = 0; i < n; ++i) {
     const LinkParameters& l = model_.getLink(i);
     coulombPos_(i) = std::abs(l.gearRatio * l.coulombFrictionPositive);
@@ -157,14 +158,27 @@ void ManipulatorSimulation::setSensor(const JointVector& countsPerRadian, int de
   setState(q_, qd_);
 }
 
+void ManipulatorSimulation::setEncoderOffset(const JointVector& offset) {
+  const int n = model_.getNumberOfJoints();
+  if (offset.size() != n)
+    throw std::invalid_argument("ManipulatorSimulation::setEncoderOffset: " + std::to_string(offset.size()) +
+                                " offsets for " + std::to_string(n) + " joints");
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(offset(i)))
+      throw std::invalid_argument("ManipulatorSimulation::setEncoderOffset: joint " + std::to_string(i + 1) +
+                                  ": the offset must be finite");
+  encoderOffset_ = offset;
+  setState(q_, qd_);
+}
+
 void ManipulatorSimulation::recordReading() {
   const auto k = static_cast<std::size_t>(head_);
-  readPosition_[k] = q_;
+  readPosition_[k] = q_ + encoderOffset_;
   readVelocity_[k] = qd_;
   // An encoder counts whole increments: the reading is the count below the position.
   for (int i = 0; i < countsPerRadian_.size(); ++i)
     if (std::isfinite(countsPerRadian_(i)))
-      readPosition_[k](i) = std::floor(q_(i) * countsPerRadian_(i)) / countsPerRadian_(i);
+      readPosition_[k](i) = std::floor(readPosition_[k](i) * countsPerRadian_(i)) / countsPerRadian_(i);
 }
 
 void ManipulatorSimulation::setBrakeTorque(const JointVector& torque) {
@@ -407,6 +421,10 @@ void ManipulatorSimulation::declareSettings(SettingSchema& schema) {
   perJointNumbers("simFrictionScale", "",
                   "simulated plant: factor on the joint friction (one for all joints, or one per joint)", 0, 10);
   schema.addNumbers("simPayload", 1, "kg", "simulated plant: point mass at the tool frame's origin", 0, 1000);
+  perJointNumbers("simEncoderOffset", "deg or mm",
+                  "simulated encoders: reading minus the joint's true position (one per joint; revolute in deg, "
+                  "prismatic in mm)",
+                  -10, 10);
   perJointNumbers("simCountsPerRadian", "counts/rad",
                   "simulated encoders: resolution (one for all joints, or one per joint)", 1, 1e12);
   schema.addInteger("simSensorDelay", "simulated sensors: delay of the joint readings [servo cycles]", 0,
@@ -423,6 +441,7 @@ void ManipulatorSimulation::declareSettings(SettingSchema& schema) {
   schema.setDefault("simInertiaScale", "1");
   schema.setDefault("simFrictionScale", "1");
   schema.setDefault("simPayload", "0");
+  schema.setDefault("simEncoderOffset", "0");
   schema.setDefault("simCountsPerRadian", "(none: exact readings)");
   schema.setDefault("simSensorDelay", "0");
   schema.setDefault("simFriction", "on");
@@ -491,6 +510,10 @@ std::unique_ptr<ManipulatorSimulation> makeSimulation(const ManipulatorModel& no
   if (section->has("simSensorDelay")) delay = static_cast<int>(section->getNumbers("simSensorDelay").at(0));
   if (counts.size() > 0) check("simCountsPerRadian", [&] { sim->setSensor(counts, 0); });
   if (delay != 0) check("simSensorDelay", [&] { sim->setSensor(counts, delay); });
+  if (JointVector offset = joints("simEncoderOffset", true); offset.size() > 0) {
+    for (int i = 0; i < n; ++i) offset(i) *= nominal.isPrismatic(i) ? 1e-3 : 3.14159265358979323846 / 180.0;
+    sim->setEncoderOffset(offset);
+  }
 
   // Initial state: revolute joints in degrees, prismatic ones in millimetres.
   JointVector q = joints("simInitialPosition", true), qd = joints("simInitialVelocity", true);

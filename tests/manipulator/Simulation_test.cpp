@@ -7,6 +7,7 @@
 #include <mujoco/mujoco.h>
 
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -454,6 +455,34 @@ TEST(SimulationPlant, SwitchesSensorsAndInitialState) {
     }
   }
   EXPECT_NE(sim->getPosition()(5), sim->getTruePosition()(5));
+}
+
+// simEncoderOffset: the readings are the plant's position plus the offset (degrees in rp.cfg),
+// then quantised; the plant itself does not move.
+TEST(SimulationPlant, EncoderOffsetShiftsTheReadingsOnly) {
+  Puma560Model nominal;
+  const Configuration config = Configuration::parse(
+      "[puma]\nclass Puma560\nsimEncoderOffset 0 0.5 -0.25 0 0 1\nsimCountsPerRadian 100000\n", "rp.cfg");
+  const auto sim = makeSimulation(nominal, &section(config));
+  const double deg = std::acos(-1.0) / 180;
+  EXPECT_EQ(sim->getTruePosition(), nominal.getHomePosition()) << "the plant starts at home";
+  const double offset[6] = {0, 0.5 * deg, -0.25 * deg, 0, 0, 1 * deg};
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_DOUBLE_EQ(sim->getEncoderOffset()(i), offset[i]);
+    EXPECT_EQ(sim->getPosition()(i), std::floor((sim->getTruePosition()(i) + offset[i]) * 1e5) / 1e5) << i + 1;
+  }
+  JointVector wrong(5);
+  EXPECT_THROW(sim->setEncoderOffset(wrong), std::invalid_argument);
+  JointVector infinite = JointVector::Zero(6);
+  infinite(2) = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(sim->setEncoderOffset(infinite), std::invalid_argument);
+  try {
+    const Configuration bad = Configuration::parse("[puma]\nclass Puma560\nsimEncoderOffset 0.1 0.2\n", "rp.cfg");
+    (void)makeSimulation(nominal, &section(bad));
+    ADD_FAILURE() << "no error for two offsets on six joints";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("rp.cfg:3:"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SimulationPlant, BadSettingsAreConfigErrorsWithTheLine) {

@@ -13,32 +13,17 @@
 #include <string>
 #include <unistd.h>
 
+#include "RunProgram.hpp"
 #include "rp/trajectory/SynchronizedJointMotion.hpp"
 
 namespace rp {
 namespace {
 
-struct Outcome {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::Outcome;
 
 Outcome runPlan(const std::string& args) {
-  const std::string base = ::testing::TempDir() + "rp_plan_" + std::to_string(::getpid());
-  const std::string command = std::string("'") + RP_PLAN_PROGRAM + "' " + args + " >" + base + ".out 2>" + base + ".err";
-  const int raw = std::system(command.c_str());
-  Outcome r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = slurp(base + ".out");
-  r.err = slurp(base + ".err");
-  return r;
+  return test::runProgram(std::string("'") + RP_PLAN_PROGRAM + "' " + args,
+                          ::testing::TempDir() + "rp_plan_" + std::to_string(::getpid()));
 }
 
 const char* kStart = "0.1,-0.5,1.2,0,0.3,-1,2";

@@ -121,6 +121,14 @@ class ManipulatorSimulation {
   void setSensor(const JointVector& countsPerRadian, int delay);
   /// The sensor delay [steps].
   int getSensorDelay() const { return delay_; }
+  /// Sets each joint's encoder offset: the reading is the plant's position plus the offset (then
+  /// quantised), as with an encoder zeroed away from the model's zero. setState() and
+  /// getTruePosition() keep the plant's positions. Real-time safe: no.
+  /// @param[in] offset  per joint (n x 1) [rad or m], finite
+  /// @throws std::invalid_argument on a wrong size or a value that is not finite
+  void setEncoderOffset(const JointVector& offset);
+  /// Each joint's encoder offset [rad or m] (zero by default).
+  const JointVector& getEncoderOffset() const { return encoderOffset_; }
 
   /// Selects the integrator (takes effect at the next step). Real-time safe: yes.
   /// @param[in] integrator  Euler or RK4
@@ -204,7 +212,7 @@ class ManipulatorSimulation {
   SimulationIntegrator integrator_ = SimulationIntegrator::RK4;
   DynamicsOptions options_;
   // Sensors: a ring of the last kMaxSensorDelay + 1 readings; head_ is the newest.
-  JointVector countsPerRadian_;
+  JointVector countsPerRadian_, encoderOffset_;
   int delay_ = 0;
   int head_ = 0;
   std::array<JointVector, kMaxSensorDelay + 1> readPosition_{}, readVelocity_{};

@@ -1,0 +1,39 @@
+// Shared by the tests that run a program as a user does (rp-plan, rp-calibrate): its exit status
+// and what it printed.
+#pragma once
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace rp::test {
+
+// What a program run left: its exit status (-1 if it did not exit) and its stdout and stderr.
+struct Outcome {
+  int status = -1;
+  std::string out, err;
+};
+
+// The whole file at `path` ("" if it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Runs `command` (a shell command line) with stdout and stderr to `base`.out and `base`.err.
+inline Outcome runProgram(const std::string& command, const std::string& base) {
+  const int raw = std::system((command + " >" + base + ".out 2>" + base + ".err").c_str());
+  Outcome r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.out = slurp(base + ".out");
+  r.err = slurp(base + ".err");
+  return r;
+}
+
+}  // namespace rp::test
