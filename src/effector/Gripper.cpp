@@ -22,6 +22,14 @@ Vector<3> point(double x, double y, double z) {
   v << x, y, z;
   return v;
 }
+
+// A length setting of the gripper: checked, then set under the gripper's lock.
+void setLength(std::mutex& mutex, double& field, double meters, bool zeroAllowed, const std::string& what) {
+  if (!std::isfinite(meters) || meters < 0 || (!zeroAllowed && meters == 0))
+    throw std::invalid_argument(what + (zeroAllowed ? " must be finite and not negative" : " must be positive and finite"));
+  std::lock_guard lock(mutex);
+  field = meters;
+}
 }  // namespace
 
 struct Gripper::Impl {
@@ -139,10 +147,7 @@ Vector<3> Gripper::getToolPoint() const {
 Transform Gripper::getToolTransform() const { return Transform(getWorldTransform() * translation(getToolPoint())); }
 
 void Gripper::setOpening(double meters) {
-  if (!(meters > 0) || !std::isfinite(meters))
-    throw std::invalid_argument(getName() + ": the opening must be positive and finite");
-  std::lock_guard lock(impl_->mutex);
-  impl_->opening = meters;
+  setLength(impl_->mutex, impl_->opening, meters, false, getName() + ": the opening");
 }
 
 double Gripper::getOpening() const {
@@ -151,10 +156,7 @@ double Gripper::getOpening() const {
 }
 
 void Gripper::setGraspTolerance(double meters) {
-  if (!(meters >= 0) || !std::isfinite(meters))
-    throw std::invalid_argument(getName() + ": the grasp tolerance must be finite and not negative");
-  std::lock_guard lock(impl_->mutex);
-  impl_->graspTolerance = meters;
+  setLength(impl_->mutex, impl_->graspTolerance, meters, true, getName() + ": the grasp tolerance");
 }
 
 double Gripper::getGraspTolerance() const {

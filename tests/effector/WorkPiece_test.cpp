@@ -8,16 +8,13 @@
 #include <vector>
 
 #include "EffectorTestSupport.hpp"
+#include "Vec3.hpp"
 #include "rp/RoboticPlatform.hpp"
 
 namespace rp {
 namespace {
 
-Vector<3> vec3(double x, double y, double z) {
-  Vector<3> v;
-  v << x, y, z;
-  return v;
-}
+using test::vec3;
 
 SimulatedClock& simClock() {
   RoboticPlatform::useSimulatedClock();

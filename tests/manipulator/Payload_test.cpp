@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "SimulatedArmTest.hpp"
+#include "Vec3.hpp"
 #include "rp/RoboticPlatform.hpp"
 #include "rp/manipulator/ManipulatorSimulation.hpp"
 #include "rp/model/Model.hpp"
@@ -13,11 +14,7 @@
 namespace rp {
 namespace {
 
-Vector<3> vec3(double x, double y, double z) {
-  Vector<3> v;
-  v << x, y, z;
-  return v;
-}
+using test::vec3;
 
 JointVector testPose() {
   JointVector q(6);
