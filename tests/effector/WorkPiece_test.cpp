@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <thread>
 #include <vector>
 
 #include "EffectorTestSupport.hpp"
@@ -30,7 +31,8 @@ class Sampler : public ControlProgram {
   }
   ~Sampler() override { stop(); }
   void control() override {
-    if (seen.size() < 2000) seen.push_back(piece_.getFallState());
+    const WorkPiece::FallState s = piece_.getFallState();
+    if (s.steps > 0 && seen.size() < 2000) seen.push_back(s);  // from the fall's first step on
   }
   std::vector<WorkPiece::FallState> seen;  // the test reads it once the loop has stopped
 
@@ -112,6 +114,8 @@ TEST_F(WorkPieceTest, AReleasedPieceFallsWithGOntoItsTable) {
   // what it sees of the fall every cycle.
   Sampler sampler(piece);
   sampler.start();
+  // Running on the clock before the fall starts (a loop joins the clock in its thread, later).
+  while (sampler.getCycleCount() < 2) std::this_thread::yield();
   ASSERT_TRUE(gripper.open());
   ASSERT_TRUE(piece.waitUntilLanded(60));
   sampler.stop();
