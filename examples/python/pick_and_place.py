@@ -3,7 +3,9 @@
 Run: PYTHONPATH=build/python python3 examples/python/pick_and_place.py -nogui [-simclock]
 
 Changes from the paper's C++ (besides those of examples/pick_and_place.cpp, whose positions
-it uses): Python names; poses are 4 x 4 numpy arrays built with numpy.
+it uses): Python names; poses are 4 x 4 numpy arrays built with numpy; no work piece and no
+gripper mount (the Python module has no WorkPiece and no setConnection yet): the arm makes the
+C++ program's motions with nothing in the gripper.
 """
 import sys
 
@@ -34,14 +36,14 @@ down = np.diag([1.0, -1.0, -1.0, 1.0])
 
 # Move to the object and pick it up
 gripper.open()
-tragen.move_to(translation(0, 0.5, 0.2) @ down)
+tragen.move_to(translation(0, 0.5, 0.12) @ down)
 tragen.stop(1)
 gripper.close()
 tragen.stop(1)
 
 # Move to the target position and drop the object
 tragen.move_to(translation(0.5, 0.5, 0.3) @ down)
-tragen.move_to(translation(0.6, 0.2, 0.2) @ down)
+tragen.move_to(translation(0.6, 0.2, 0.3) @ down)
 tragen.stop(1)
 gripper.open()
 tragen.stop(1)

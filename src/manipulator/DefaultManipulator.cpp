@@ -18,6 +18,7 @@
 #include "rp/rt/Clock.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
 #include "LinkShapes.hpp"
+#include "PayloadHandover.hpp"
 
 namespace rp {
 
@@ -89,6 +90,14 @@ int firstNonFinite(const JointVector& v) {
 }
 }  // namespace
 
+// The payload of setPayload(): kept for makeSetup() and getPayload...() under setupMutex_, and handed
+// to the servo thread.
+struct DefaultManipulator::PayloadBox {
+  double mass = 0;
+  Vector<3> centre = Vector<3>::Zero();
+  internal::PayloadHandover<4> handover;  // mass [kg], centre [m]
+};
+
 struct DefaultManipulator::Setup {
   std::unique_ptr<ManipulatorModel> model;
   std::unique_ptr<ManipulatorData> data;
@@ -121,6 +130,7 @@ std::unique_ptr<DefaultManipulator::Setup> DefaultManipulator::makeSetup(bool si
   }
   setup->data = std::make_unique<ManipulatorData>(*setup->model);
   setup->sim = makeSimulation(*setup->model, configSection());  // the plant, with rp.cfg's deviations
+  if (payload_ != nullptr && payload_->mass > 0) setup->sim->setPayload(payload_->mass, payload_->centre);
   return setup;
 }
 
@@ -279,6 +289,7 @@ DefaultManipulator::DefaultManipulator(const std::string& name, const ModelFacto
   builtBase_ = getWorldTransform();
   std::unique_ptr<Setup> setup = makeSetup(builtForSimulation_, builtBase_);
   install(*setup);
+  payload_ = std::make_unique<PayloadBox>();
   const int n = model_->getNumberOfJoints();
   wrench_ = std::make_unique<WrenchBox>();
   for (JointVector* v : {&q_, &qd_, &tau_, &gravity_, &hold_}) v->setZero(n);
@@ -894,7 +905,7 @@ void DefaultManipulator::control() {
   if (phase != 0) {
     holdTorque();
   } else if (gravityCompensation_.load(std::memory_order_relaxed) || zeroG) {
-    gravityTorque(*model_, *data_, q_, gravity_);
+    gravityWithPayload();
     tau_ += gravity_;
   }
 
@@ -992,8 +1003,48 @@ void DefaultManipulator::fault(const char* format, ...) noexcept {
 void DefaultManipulator::holdTorque() {
   // Velocity damping with the default derivative gains, plus gravity; within the torque limits.
   tau_ = -(defaultControl_->getKd().cwiseProduct(qd_));
-  gravityTorque(*model_, *data_, q_, gravity_);
+  gravityWithPayload();
   tau_ += gravity_;
+}
+
+void DefaultManipulator::gravityWithPayload() {
+  gravityTorque(*model_, *data_, q_, gravity_);
+  std::array<double, 4> v{};
+  if (payload_->handover.tryLoad(v)) {  // being changed: the next cycle takes it
+    payloadMass_ = v[0];
+    payloadCentre_ << v[1], v[2], v[3];
+  }
+  if (payloadMass_ == 0) return;
+  // The weight W = m g at the centre p: the torque that holds it is -J_p^T W, J_p's columns the
+  // end-effector's (Jv_j + Jw_j x (p - e)).
+  const Jacobian& J = jacobian(*model_, *data_, q_, ReferenceFrame::Base);
+  const Transform& e = data_->endEffector;
+  const Eigen::Vector3d r = e.topLeftCorner<3, 3>() * Eigen::Vector3d(payloadCentre_);
+  const Eigen::Vector3d weight = payloadMass_ * Eigen::Vector3d(model_->getGravity());
+  for (int j = 0; j < gravity_.size(); ++j)
+    gravity_(j) -= (J.col(j).head<3>() + J.col(j).tail<3>().cross(r)).dot(weight);
+}
+
+void DefaultManipulator::setPayload(double mass, const Vector<3>& centre) {
+  if (!std::isfinite(mass) || mass < 0)
+    throw std::invalid_argument("manipulator '" + getName() + "': the payload mass must be finite and not negative");
+  if (!centre.allFinite())
+    throw std::invalid_argument("manipulator '" + getName() + "': the payload centre must be finite");
+  std::lock_guard<std::mutex> lock(setupMutex_);  // the simulation is replaced only under it
+  sim_->setPayload(mass, centre);
+  payload_->mass = mass;
+  payload_->centre = centre;
+  payload_->handover.store({mass, centre(0), centre(1), centre(2)});
+}
+
+double DefaultManipulator::getPayloadMass() const {
+  std::lock_guard<std::mutex> lock(setupMutex_);
+  return payload_->mass;
+}
+
+Vector<3> DefaultManipulator::getPayloadCentre() const {
+  std::lock_guard<std::mutex> lock(setupMutex_);
+  return payload_->centre;
 }
 
 void DefaultManipulator::powerOffNow() noexcept {

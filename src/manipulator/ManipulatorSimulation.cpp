@@ -3,11 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "PayloadHandover.hpp"
 #include "rp/core/Configuration.hpp"
 
 namespace rp {
@@ -50,6 +52,26 @@ JointVector perJoint(const JointVector& v, int n, double fallback, bool zeroAllo
   return v;
 }
 
+// A model of `nominal`'s chain with each link's parameters passed through `edit(link, joint, l)`
+// (joint: the model's joint that moves the link; with mimic joints the link of a mimic joint takes
+// the values of the joint it follows).
+template <typename Edit>
+std::unique_ptr<const ManipulatorModel> rebuild(const ManipulatorModel& nominal, const Edit& edit) {
+  const ManipulatorModel& chain = nominal.getChain();
+  std::vector<LinkParameters> links;
+  for (int k = 0; k < chain.getNumberOfJoints(); ++k) {
+    const int i = nominal.hasMimicJoints() ? nominal.getCoupling()[static_cast<std::size_t>(k)].joint : k;
+    LinkParameters l = chain.getLink(k);
+    edit(k, i, l);
+    links.push_back(l);
+  }
+  if (nominal.hasMimicJoints())
+    return std::make_unique<PlantModel>(
+        nominal, std::make_shared<const ManipulatorModel>(chain.getName(), std::move(links), chain.getBaseTransform(),
+                                                          chain.getToolTransform(), chain.getGravity(), chain.getConvention()));
+  return std::make_unique<PlantModel>(nominal, std::move(links));
+}
+
 std::unique_ptr<const ManipulatorModel> buildPlant(const ManipulatorModel& nominal, const PlantDeviations& d) {
   const int n = nominal.getNumberOfJoints();
   const JointVector mass = perJoint(d.massScale, n, 1.0, false, "mass scale");
@@ -57,13 +79,10 @@ std::unique_ptr<const ManipulatorModel> buildPlant(const ManipulatorModel& nomin
   const JointVector friction = perJoint(d.frictionScale, n, 1.0, true, "friction scale");
   if (!std::isfinite(d.payload) || d.payload < 0)
     throw std::invalid_argument("ManipulatorSimulation: the payload must be finite and not negative");
-  // The deviations act on every link of the chain (with mimic joints: a mimic joint's link takes
-  // the values of the joint it follows).
-  const ManipulatorModel& chain = nominal.getChain();
-  std::vector<LinkParameters> links;
-  for (int k = 0; k < chain.getNumberOfJoints(); ++k) {
-    const int i = nominal.hasMimicJoints() ? nominal.getCoupling()[static_cast<std::size_t>(k)].joint : k;
-    LinkParameters l = chain.getLink(k);
+  const int last = nominal.getChain().getNumberOfJoints() - 1;
+  // A point mass at the tool frame's origin, in the last link's frame.
+  const Eigen::Vector3d p = nominal.getToolTransform().topRightCorner<3, 1>();
+  return rebuild(nominal, [&](int k, int i, LinkParameters& l) {
     l.mass *= mass(i);
     l.inertia = Matrix<3, 3>(Eigen::Matrix3d(l.inertia) * inertia(i));
     const double f = d.friction ? friction(i) : 0.0;
@@ -71,13 +90,9 @@ std::unique_ptr<const ManipulatorModel> buildPlant(const ManipulatorModel& nomin
     l.coulombFrictionPositive *= f;
     l.coulombFrictionNegative *= f;
     if (!d.motorInertia) l.motorInertia = 0;
-    links.push_back(l);
-  }
-  if (d.payload > 0) {
-    // A point mass at the tool frame's origin, in the last link's frame: the link's mass, centre
-    // of mass and inertia about it combine with it (parallel-axis theorem).
-    LinkParameters& l = links.back();
-    const Eigen::Vector3d p = nominal.getToolTransform().topRightCorner<3, 1>();
+    if (k != last || d.payload <= 0) return;
+    // The point mass and the link's mass, centre of mass and inertia about it combine (parallel-axis
+    // theorem).
     const Eigen::Vector3d c = l.com;
     const double m = l.mass + d.payload;
     const Eigen::Vector3d cNew = (l.mass * c + d.payload * p) / m;
@@ -87,15 +102,63 @@ std::unique_ptr<const ManipulatorModel> buildPlant(const ManipulatorModel& nomin
     l.inertia = Matrix<3, 3>(Eigen::Matrix3d(l.inertia) + shift(l.mass, c - cNew) + shift(d.payload, p - cNew));
     l.com = Vector<3>(cNew);
     l.mass = m;
+  });
+}
+
+// The chain of `plant` with massless, frictionless links but for 1 kg at `centre` (end-effector
+// frame) on the last link: the dynamics of a unit payload there.
+std::unique_ptr<const ManipulatorModel> buildUnitPayload(const ManipulatorModel& plant, const Vector<3>& centre) {
+  const int last = plant.getChain().getNumberOfJoints() - 1;
+  const Transform& tool = plant.getToolTransform();
+  const Eigen::Vector3d p = tool.topLeftCorner<3, 3>() * Eigen::Vector3d(centre) + tool.topRightCorner<3, 1>();
+  return rebuild(plant, [&](int k, int, LinkParameters& l) {
+    l.mass = k == last ? 1.0 : 0.0;
+    l.com = k == last ? Vector<3>(p) : Vector<3>::Zero();
+    l.inertia = Matrix<3, 3>::Zero();
+    l.motorInertia = 0;
+    l.viscousFriction = l.coulombFrictionPositive = l.coulombFrictionNegative = 0;
+  });
+}
+
+// Solves A x = b for a symmetric positive definite A by Cholesky (A = L L^T), without allocation.
+void choleskySolve(const JointMatrix& A, const JointVector& b, JointMatrix& L, JointVector& x) {
+  const auto n = static_cast<int>(A.rows());
+  for (int j = 0; j < n; ++j) {
+    double d = A(j, j);
+    for (int m = 0; m < j; ++m) d -= L(j, m) * L(j, m);
+    L(j, j) = std::sqrt(d);
+    for (int i = j + 1; i < n; ++i) {
+      double s = A(i, j);
+      for (int m = 0; m < j; ++m) s -= L(i, m) * L(j, m);
+      L(i, j) = s / L(j, j);
+    }
   }
-  if (nominal.hasMimicJoints())
-    return std::make_unique<PlantModel>(
-        nominal, std::make_shared<const ManipulatorModel>(chain.getName(), std::move(links), chain.getBaseTransform(),
-                                                          chain.getToolTransform(), chain.getGravity(), chain.getConvention()));
-  return std::make_unique<PlantModel>(nominal, std::move(links));
+  x = b;
+  for (int i = 0; i < n; ++i) {
+    for (int m = 0; m < i; ++m) x(i) -= L(i, m) * x(m);
+    x(i) /= L(i, i);
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    for (int m = i + 1; m < n; ++m) x(i) -= L(m, i) * x(m);
+    x(i) /= L(i, i);
+  }
 }
 
 }  // namespace
+
+// The unit payload models by centre, kept for the simulation's life (the stepping thread may use
+// any of them), and the hand-over of (mass, centre index) to the stepping thread.
+struct ManipulatorSimulation::Payload {
+  struct Unit {
+    Vector<3> centre;
+    std::unique_ptr<const ManipulatorModel> model;
+    std::unique_ptr<ManipulatorData> data;  // the stepping thread's
+  };
+  std::mutex mutex;  // serialises setPayload()
+  std::array<Unit, kMaxPayloadCentres> units;
+  int count = 0;
+  internal::PayloadHandover<2> handover;  // mass [kg], centre index
+};
 
 ManipulatorSimulation::ManipulatorSimulation(const ManipulatorModel& model) : model_(model), data_(model) { init(); }
 
@@ -114,6 +177,10 @@ void ManipulatorSimulation::init() {
     v->setZero(n);
   A_.setZero(n, n);
   L_.setZero(n, n);
+  payloadMass_.setZero(n, n);
+  payloadBias_.setZero(n);
+  zero_.setZero(n);
+  payload_ = std::make_unique<Payload>();
   brakeTorque_ = model_.getTorqueLimit();
   encoderOffset_.setZero(n);
   for (int i = 0; i < n; ++i) {
@@ -127,6 +194,59 @@ void ManipulatorSimulation::init() {
   options_.motorInertia = true;
   options_.friction = false;  // viscous friction implicit (Euler) or explicit (RK4), Coulomb as a constraint
   setState(q_, qd_);
+}
+
+void ManipulatorSimulation::setPayload(double mass, const Vector<3>& centre) {
+  if (!std::isfinite(mass) || mass < 0)
+    throw std::invalid_argument("ManipulatorSimulation::setPayload: the mass must be finite and not negative");
+  if (!centre.allFinite()) throw std::invalid_argument("ManipulatorSimulation::setPayload: the centre must be finite");
+  Payload& p = *payload_;
+  std::lock_guard<std::mutex> lock(p.mutex);
+  int index = -1;
+  for (int i = 0; i < p.count; ++i)
+    if (p.units[static_cast<std::size_t>(i)].centre == centre) index = i;
+  if (index < 0 && mass > 0) {
+    if (p.count == kMaxPayloadCentres)
+      throw std::length_error("ManipulatorSimulation::setPayload: more than " + std::to_string(kMaxPayloadCentres) +
+                              " different payload centres");
+    Payload::Unit& u = p.units[static_cast<std::size_t>(p.count)];
+    u.centre = centre;
+    u.model = buildUnitPayload(model_, centre);
+    u.data = std::make_unique<ManipulatorData>(*u.model);
+    index = p.count++;  // complete before the hand-over below publishes it
+  }
+  p.handover.store({mass, static_cast<double>(index)});
+}
+
+void ManipulatorSimulation::takePayload() noexcept {
+  std::array<double, 2> v{};
+  if (!payload_->handover.tryLoad(v)) return;  // being changed: the next step takes it
+  stepCentre_ = static_cast<int>(v[1]);
+  stepMass_ = stepCentre_ < 0 ? 0.0 : v[0];
+}
+
+void ManipulatorSimulation::dynamics(const JointVector& tau) {
+  if (stepMass_ == 0) {
+    forwardDynamics(model_, data_, q_, qd_, tau, options_);
+    return;
+  }
+  // (M + m M_u) qdd = tau - h - m h_u: the arm's forward dynamics under tau - m h_u gives M and
+  // M qdd' = tau - h - m h_u, which is the right-hand side.
+  Payload::Unit& u = payload_->units[static_cast<std::size_t>(stepCentre_)];
+  payloadBias_ = tau - stepMass_ * inverseDynamics(*u.model, *u.data, q_, qd_, zero_);
+  forwardDynamics(model_, data_, q_, qd_, payloadBias_, options_);
+  payloadBias_.noalias() = data_.massMatrix * data_.qdd;
+  payloadMass_ = data_.massMatrix + stepMass_ * massMatrix(*u.model, *u.data, q_);
+  choleskySolve(payloadMass_, payloadBias_, L_, data_.qdd);
+  data_.massMatrix = payloadMass_;
+}
+
+const JointMatrix& ManipulatorSimulation::plantMassMatrix() {
+  const JointMatrix& M = massMatrix(model_, data_, q_, true);
+  if (stepMass_ == 0) return M;
+  data_.massMatrix += stepMass_ * massMatrix(*payload_->units[static_cast<std::size_t>(stepCentre_)].model,
+                                             *payload_->units[static_cast<std::size_t>(stepCentre_)].data, q_);
+  return data_.massMatrix;
 }
 
 void ManipulatorSimulation::setState(const JointVector& q, const JointVector& qd) {
@@ -194,6 +314,7 @@ void ManipulatorSimulation::setBrakeTorque(const JointVector& torque) {
 
 void ManipulatorSimulation::step(const JointVector& tau, double dt) {
   const int n = model_.getNumberOfJoints();
+  takePayload();
   externalTorque();  // constant over the step
   // With the brakes on the amplifiers are off: no motor torque.
   for (int i = 0; i < n; ++i)
@@ -208,7 +329,7 @@ void ManipulatorSimulation::step(const JointVector& tau, double dt) {
   };
   for (int i = 0; i < n; ++i) atStop = atStop || nearStop(i);
   if (atStop) {
-    const JointMatrix& M = massMatrix(model_, data_, q_, true);
+    const JointMatrix& M = plantMassMatrix();
     for (int i = 0; i < n; ++i) {
       if (!nearStop(i)) continue;
       const double omega = std::sqrt(stopStiffness_ / M(i, i));
@@ -283,7 +404,7 @@ void ManipulatorSimulation::eulerStep(double h) {
     if (!engaged_[static_cast<std::size_t>(i)]) continue;
     tauTotal_(i) += k * ((q_(i) > hi || next > hi ? hi : lo) - q_(i));
   }
-  forwardDynamics(model_, data_, q_, qd_, tauTotal_, options_);
+  dynamics(tauTotal_);
   const JointMatrix& M = data_.massMatrix;
   for (int i = 0; i < n; ++i) {
     diag_(i) = viscous_(i);
@@ -300,25 +421,7 @@ void ManipulatorSimulation::eulerStep(double h) {
   for (int i = 0; i < n; ++i) A_(i, i) += h * diag_(i);
   // v* = A^-1 rhs by Cholesky (A is positive definite); without implicit terms v* = v0 exactly.
   if (diag_.cwiseAbs().maxCoeff() > 0) {
-    for (int j = 0; j < n; ++j) {
-      double d = A_(j, j);
-      for (int m = 0; m < j; ++m) d -= L_(j, m) * L_(j, m);
-      L_(j, j) = std::sqrt(d);
-      for (int i = j + 1; i < n; ++i) {
-        double s = A_(i, j);
-        for (int m = 0; m < j; ++m) s -= L_(i, m) * L_(j, m);
-        L_(i, j) = s / L_(j, j);
-      }
-    }
-    kv_ = rhs_;
-    for (int i = 0; i < n; ++i) {
-      for (int m = 0; m < i; ++m) kv_(i) -= L_(i, m) * kv_(m);
-      kv_(i) /= L_(i, i);
-    }
-    for (int i = n - 1; i >= 0; --i) {
-      for (int m = i + 1; m < n; ++m) kv_(i) -= L_(m, i) * kv_(m);
-      kv_(i) /= L_(i, i);
-    }
+    choleskySolve(A_, rhs_, L_, kv_);
   } else {
     kv_ = v0_;
   }
@@ -339,7 +442,7 @@ void ManipulatorSimulation::rk4Step(double h) {
   sumV_.setZero();
   for (int s = 0; s < 4; ++s) {
     tauTotal_ = tauApplied_ - viscous_.cwiseProduct(qd_);
-    forwardDynamics(model_, data_, q_, qd_, tauTotal_, options_);
+    dynamics(tauTotal_);
     kq_ = qd_;
     kv_ = data_.qdd;
     if (s == 0) qdd_ = kv_;

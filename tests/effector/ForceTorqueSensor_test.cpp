@@ -14,17 +14,14 @@
 #include "EffectorTestSupport.hpp"
 #include "WaitFor.hpp"
 #include "NetFtEmulator.hpp"
+#include "Vec3.hpp"
 #include "rp/effector/AtiFTSensor.hpp"
 #include "rp/math/Transform.hpp"
 
 namespace rp {
 namespace {
 
-Vector<3> vec3(double x, double y, double z) {
-  Vector<3> v;
-  v << x, y, z;
-  return v;
-}
+using test::vec3;
 
 using emulator::NetFtEmulator;
 using test::contains;

@@ -10,6 +10,7 @@
 
 #include "EffectorTestSupport.hpp"
 #include "ModbusEmulator.hpp"
+#include "Vec3.hpp"
 #include "rp/effector/DefaultGripper.hpp"
 #include "rp/io/SimulatedIoBoard.hpp"
 #include "rp/math/Transform.hpp"
@@ -17,11 +18,7 @@
 namespace rp {
 namespace {
 
-Vector<3> vec3(double x, double y, double z) {
-  Vector<3> v;
-  v << x, y, z;
-  return v;
-}
+using test::vec3;
 
 using test::contains;
 

@@ -945,6 +945,16 @@ TEST_F(ManipulatorTest, TheServoCycleDoesNotAllocate) {
   point(0) = -0.2;
   puma.applyExternalWrench(2, point, push);
   while (probe.cycles() < 2000) puma.waitForCycles(100);
+  // A payload picked up and put down: the servo thread takes it for the gravity compensation
+  // and the simulated plant (whose unit payload model setPayload() built in this thread).
+  Vector<3> centre;
+  centre(2) = 0.1;
+  puma.setPayload(1.5, centre);
+  while (probe.cycles() < 3000) puma.waitForCycles(100);
+  puma.setPayload(0, centre);
+  while (probe.cycles() < 3500) puma.waitForCycles(100);
+  puma.setPayload(0.7, centre);
+  while (probe.cycles() < 4000) puma.waitForCycles(100);
   simClock().pause();
   EXPECT_EQ(probe.allocations(), 0u);
 }

@@ -649,9 +649,14 @@ TEST(SimulationRealTime, SteppingDoesNotAllocate) {
     Vector<6> push;
     push(0) = 5;
     sim->setExternalWrench(push);
+    Vector<3> centre;
+    centre(2) = 0.1;
+    sim->setPayload(2.0, centre);  // builds the unit payload model of this centre
     test::AllocationGuard guard;
     for (int k = 0; k < 200; ++k) {
       sim->setBrakes(k > 100);
+      if (k == 50) sim->setPayload(0.5, centre);  // a centre used before: nothing to build
+      if (k == 150) sim->setPayload(0, centre);
       sim->step(tau, 1e-3);
     }
     EXPECT_EQ(guard.count(), 0u);

@@ -79,13 +79,17 @@ TEST(OfflinePlanner, BlendingAtAViaPointShortensThePlanAndDwellsAndCapacityAreKe
   EXPECT_LT(blend.duration, stop.duration - 0.05) << "a blend does not stop at the via point";
   EXPECT_NEAR(blend.q(blend.q.rows() - 1, 1), target(1), 1e-12);
 
+  // A dwell adds its time to motions that stop at the via point (radius 0: blending is on by
+  // default).
   OfflinePlanner planner(puma, home);
+  planner.generator().setJointBlendRadius(0);
   planner.generator().moveRadians(via);
   planner.dwell(0.5);
   planner.generator().moveRadians(home);
   const OfflinePlanner::Samples dwell = planner.sample(1000);
   const OfflinePlanner::Samples noDwell = [&] {
     OfflinePlanner p(puma, home);
+    p.generator().setJointBlendRadius(0);
     p.generator().moveRadians(via);
     p.generator().moveRadians(home);
     return p.sample(1000);

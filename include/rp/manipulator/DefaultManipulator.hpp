@@ -166,6 +166,27 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
 
   void applyExternalWrench(const Vector<6>& wrench) override;
   void applyExternalWrench(int link, const Vector<3>& point, const Vector<6>& wrench) override;
+
+  /// Sets the payload the arm carries (a gripper sets it when it grasps and releases a work
+  /// piece): a point mass at `centre` in the end-effector frame. From the next servo cycle both
+  /// the gravity compensation (and the damped hold of a shutdown) and, in simulation mode, the
+  /// simulated plant carry it: the gravity torque gains \f$-J_p(q)^T m\,g\f$, with \f$J_p\f$
+  /// the translational Jacobian of the centre and \f$g\f$ the model's gravity, and the plant's
+  /// dynamics the point mass (see ManipulatorSimulation::setPayload(); it adds to rp.cfg's
+  /// `simPayload`). The servo thread takes the payload between two cycles without a lock or an
+  /// allocation; a change of pose or simulation mode keeps it. The servo control itself (a
+  /// DefaultPositionControl) has no model and is not changed.
+  /// @param[in] mass    payload mass [kg] (0: none)
+  /// @param[in] centre  centre of mass in the end-effector frame [m]
+  /// @throws std::invalid_argument for a negative or non-finite mass or a non-finite centre
+  /// @throws std::length_error from ManipulatorSimulation::setPayload() (too many centres)
+  /// Real-time safe: no.
+  void setPayload(double mass, const Vector<3>& centre = Vector<3>::Zero());
+  /// The payload mass last set [kg]. Real-time safe: no.
+  double getPayloadMass() const;
+  /// The payload's centre of mass last set, in the end-effector frame [m]. Real-time safe: no.
+  Vector<3> getPayloadCentre() const;
+
   void releaseServoControl(ServoControl& control) override;
   void releaseTrajectoryGenerator(TrajectoryGenerator& generator) override;
 
@@ -238,6 +259,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
     double q[kMaxJoints] = {}, qd[kMaxJoints] = {}, tau[kMaxJoints] = {}, qdes[kMaxJoints] = {};
   };
   struct WrenchBox;
+  struct PayloadBox;
   struct Setup;  // what is built from the pose and the simulation mode
 
   enum class SetupResult { kApplied, kShutdown, kDriven, kMoving, kHardwareFailed };
@@ -257,6 +279,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   // requests the system shutdown; the first fault wins. Real-time safe.
   void fault(const char* format, ...) noexcept __attribute__((format(printf, 2, 3)));
   void holdTorque();
+  void gravityWithPayload();  // gravity_ at q_, with the payload's weight
   void saturate() noexcept;  // tau_ within the torque limits; saturatedJoints_ counts the joints
   void powerOffNow() noexcept;
   void finishCycle(double t, double dt);
@@ -272,7 +295,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   std::unique_ptr<ManipulatorModel> model_;  // servo thread's; other threads use getModel()
   std::atomic<const ManipulatorModel*> modelView_{nullptr};
   std::vector<std::unique_ptr<ManipulatorModel>> retiredModels_;  // kept for references taken earlier
-  std::mutex setupMutex_;                                         // one pose or mode change at a time
+  mutable std::mutex setupMutex_;                                 // one pose, mode or payload change at a time
   std::atomic<Setup*> pendingSetup_{nullptr};                     // for the servo thread to take
   std::atomic<Setup*> appliedSetup_{nullptr};                     // the servo thread took this one
   std::atomic<int> setupResult_{0};                               // and what became of it (SetupResult)
@@ -286,6 +309,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   std::vector<ServoControl*> offers_;  // the servo controls the operator can switch to
   std::unique_ptr<DefaultPositionControl> defaultControl_;
   std::unique_ptr<WrenchBox> wrench_;
+  std::unique_ptr<PayloadBox> payload_;
   std::unique_ptr<IoBoard> board_;  // hardware server client, when simulation mode is off
   double countsPerRadian_ = 20000;
   std::unique_ptr<Differentiator<JointVector>> velocity_;
@@ -309,6 +333,8 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
 
   // Servo-thread state.
   JointVector q_, qd_, tau_, gravity_, hold_;
+  double payloadMass_ = 0;  // the payload the servo thread took last [kg]
+  Vector<3> payloadCentre_ = Vector<3>::Zero();  // its centre in the end-effector frame [m]
   Setpoint setpoint_;
   bool power_ = false;
   double restTime_ = 0, shutdownStart_ = 0;

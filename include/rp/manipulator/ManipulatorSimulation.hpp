@@ -62,11 +62,22 @@ struct PlantDeviations {
 /// getVelocity() give the readings (quantised to the encoder resolution, delayed by a number of
 /// steps, see setSensor()), getTruePosition() and getTrueVelocity() the plant's state.
 ///
-/// Deterministic: the same inputs give bit-identical states. Nothing allocates after construction.
+/// A payload changed at run time (setPayload(): a gripper grasping or releasing a work piece) is
+/// a point mass on the last link, in addition to PlantDeviations::payload. The dynamics are linear
+/// in the links' inertial parameters, so its part is its mass times that of a unit point mass at
+/// its centre: the simulation adds \f$m M_u(q)\f$ to the mass matrix and \f$m h_u(q, \dot q)\f$
+/// (gravity, Coriolis and centrifugal) to the bias torques, both from a model of the same chain
+/// with massless links and 1 kg at the centre (built by setPayload(), in the caller's thread).
+/// The result is the plant a PlantDeviations payload at that point gives, to rounding.
+///
+/// Deterministic: the same inputs give bit-identical states. Nothing allocates after construction
+/// (except setPayload() with a centre not used before, in its caller's thread).
 class ManipulatorSimulation {
  public:
   /// Largest sensor delay [steps].
   static constexpr int kMaxSensorDelay = 16;
+  /// Largest number of different payload centres setPayload() accepts over the simulation's life.
+  static constexpr int kMaxPayloadCentres = 16;
 
   /// Creates a simulation at rest in `model`'s home position, of the nominal plant.
   /// @param[in] model  the manipulator model (must outlive the simulation)
@@ -175,6 +186,20 @@ class ManipulatorSimulation {
   /// the positions the step started from). Real-time safe: yes.
   const JointVector& getExternalTorque() const { return tauExt_; }
 
+  /// Sets the payload the arm carries from the next step() on: a point mass at `centre` in the
+  /// end-effector (tool) frame, carried by the last link (in addition to PlantDeviations::payload).
+  /// May be called from any thread while another one steps the simulation: the stepping thread
+  /// takes the new payload at the start of a step, without a lock or an allocation (see the class
+  /// comment). Calls are serialised among themselves.
+  /// @param[in] mass    payload mass [kg] (0: none)
+  /// @param[in] centre  centre of mass in the end-effector frame [m]
+  /// @throws std::invalid_argument for a negative or non-finite mass or a non-finite centre
+  /// @throws std::length_error for a centre beyond the kMaxPayloadCentres different ones kept
+  /// Real-time safe: no (a centre not used before builds a model).
+  void setPayload(double mass, const Vector<3>& centre = Vector<3>::Zero());
+  /// The payload mass the last step() used [kg] (0 before the first step). Real-time safe: yes.
+  double getPayloadMass() const { return stepMass_; }
+
   /// Stiffness of the joint stops [N m/rad] (default 2e4).
   /// @param[in] stiffness  > 0
   void setStopStiffness(double stiffness) { stopStiffness_ = stiffness; }
@@ -192,6 +217,17 @@ class ManipulatorSimulation {
     return static_cast<std::size_t>((head_ + kMaxSensorDelay + 1 - delay_) % (kMaxSensorDelay + 1));
   }
   void externalTorque();
+  void takePayload() noexcept;  // the payload of setPayload(), at the start of a step
+  void dynamics(const JointVector& tau);  // forward dynamics with the payload: data_.qdd, data_.massMatrix
+  const JointMatrix& plantMassMatrix();   // the mass matrix at q_ with motor inertia and the payload
+
+  struct Payload;  // the unit point-mass models by centre and the hand-over
+  std::unique_ptr<Payload> payload_;
+  double stepMass_ = 0;      // the payload of the current step [kg]
+  int stepCentre_ = -1;      // its unit model (index into Payload's), -1: none
+  JointVector payloadBias_;  // scratch: the arm's torques less the payload's bias
+  JointVector zero_;         // zero accelerations (the payload's bias torques)
+  JointMatrix payloadMass_;  // scratch: the mass matrix with the payload
 
   std::unique_ptr<const ManipulatorModel> own_;  // the plant's model when it deviates
   const ManipulatorModel& model_;

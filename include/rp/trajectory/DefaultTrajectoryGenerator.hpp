@@ -27,8 +27,8 @@ namespace rp {
 /// joints, which cannot follow an arbitrary line, and arms that start from a singular
 /// configuration (such as the Puma's ready pose, arm straight up and wrist stretched), from which
 /// no straight line is defined, move there in joint space instead (inverse kinematics on the
-/// previous target's configuration). Motions blend at via points when a blend radius is set
-/// (see QueueTrajectoryGenerator). A target outside the joint limits, or a pose the arm cannot
+/// previous target's configuration). Motions blend at via points (on by default; radius 0 stops
+/// there; see QueueTrajectoryGenerator). A target outside the joint limits, or a pose the arm cannot
 /// reach along the line, is refused with std::invalid_argument when it is queued, before the arm
 /// moves.
 ///

@@ -32,7 +32,8 @@ struct SegmentPlan;
 /// Time: the first segment queued while the generator is idle starts in the first servo cycle
 /// that sees it; every later segment starts exactly when the one before it ends.
 ///
-/// Blending: with a blend radius set (setJointBlendRadius(), setCartesianBlendRadius()), a
+/// Blending: with a blend radius (setJointBlendRadius(), setCartesianBlendRadius(); on by default,
+/// kDefaultJointBlendRadius and kDefaultCartesianBlendRadius; 0 stops at every target), a
 /// motion does not stop at the target before the next one. Once the arm comes within the radius
 /// of that via point, it leaves the first motion and joins the next one where that is the radius
 /// away from the via point, along a quintic in joint space that matches position, velocity and
@@ -49,6 +50,10 @@ class QueueTrajectoryGenerator : public TrajectoryGenerator {
  public:
   /// Largest number of queued segments.
   static constexpr int kCapacity = 64;
+  /// The joint blend radius of a new generator: 0.1 rad (5.7 degrees) from a via point.
+  static constexpr double kDefaultJointBlendRadius = 0.1;
+  /// The Cartesian blend radius of a new generator: 0.02 m from a via point.
+  static constexpr double kDefaultCartesianBlendRadius = 0.02;
 
   /// Creates an empty generator.
   /// @param[in] name  object name; empty for an automatic name
@@ -96,15 +101,15 @@ class QueueTrajectoryGenerator : public TrajectoryGenerator {
   /// The limits of straight-line Cartesian motion.
   CartesianLimits getCartesianLimits() const;
   /// Sets the blend radius of joint motions queued from now on: the Euclidean distance in joint
-  /// space [rad] from a via point at which the arm leaves one motion for the next. 0 (the
-  /// default) stops at every target.
+  /// space [rad] from a via point at which the arm leaves one motion for the next (default
+  /// kDefaultJointBlendRadius). 0 stops at every target.
   /// @throws std::invalid_argument for a negative radius
   void setJointBlendRadius(double radians);
   /// The blend radius of joint motions [rad].
   double getJointBlendRadius() const;
   /// Sets the blend radius of Cartesian motions queued from now on: the distance along the line
-  /// [m] from a via point at which the arm leaves one motion for the next. 0 (the default) stops
-  /// at every target.
+  /// [m] from a via point at which the arm leaves one motion for the next (default
+  /// kDefaultCartesianBlendRadius). 0 stops at every target.
   /// @throws std::invalid_argument for a negative radius
   void setCartesianBlendRadius(double metres);
   /// The blend radius of Cartesian motions [m].
@@ -168,7 +173,7 @@ class QueueTrajectoryGenerator : public TrajectoryGenerator {
   std::uint64_t lastMotion_ = 0;  // index + 1 of the last queued motion that may blend (0: none)
   int blends_ = 0;
   double speedFraction_ = 0.8;
-  double jointBlendRadius_ = 0, cartesianBlendRadius_ = 0;
+  double jointBlendRadius_ = kDefaultJointBlendRadius, cartesianBlendRadius_ = kDefaultCartesianBlendRadius;
   Synchronization synchronization_ = Synchronization::Time;
   CartesianLimits cartesianLimits_;
   JointVector userVelocity_, userAcceleration_, userJerk_;  // empty: the model's
