@@ -405,22 +405,22 @@ void MassMatrix_Pinocchio(benchmark::State& s) {
   std::size_t k = 0;
   for (auto _ : s) benchmark::DoNotOptimize(pinocchio::crba(p.model, *p.data, p.q[k++ & 63], convention).data());
 }
-void InverseDynamics_Pinocchio(benchmark::State& s) {
+// Newton-Euler (rnea) or, with forward, the articulated-body algorithm (aba) on the same states.
+template <bool forward>
+void pinocchioDynamics(benchmark::State& s) {
   PinocchioArm& p = pinocchioArm(s);
   std::size_t k = 0;
   for (auto _ : s) {
     const std::size_t i = k++ & 63;
-    benchmark::DoNotOptimize(pinocchio::rnea(p.model, *p.data, p.q[i], p.qd[i], p.qdd[i]).data());
+    if constexpr (forward) {
+      benchmark::DoNotOptimize(pinocchio::aba(p.model, *p.data, p.q[i], p.qd[i], p.qdd[i]).data());
+    } else {
+      benchmark::DoNotOptimize(pinocchio::rnea(p.model, *p.data, p.q[i], p.qd[i], p.qdd[i]).data());
+    }
   }
 }
-void ForwardDynamics_Pinocchio(benchmark::State& s) {
-  PinocchioArm& p = pinocchioArm(s);
-  std::size_t k = 0;
-  for (auto _ : s) {
-    const std::size_t i = k++ & 63;
-    benchmark::DoNotOptimize(pinocchio::aba(p.model, *p.data, p.q[i], p.qd[i], p.qdd[i]).data());
-  }
-}
+void InverseDynamics_Pinocchio(benchmark::State& s) { pinocchioDynamics<false>(s); }
+void ForwardDynamics_Pinocchio(benchmark::State& s) { pinocchioDynamics<true>(s); }
 BENCHMARK(MassMatrix_Pinocchio)->Args({6, 0})->Args({6, 1})->Args({7, 0})->Args({7, 1});
 BENCHMARK(InverseDynamics_Pinocchio)->Arg(6)->Arg(7);
 BENCHMARK(ForwardDynamics_Pinocchio)->Arg(6)->Arg(7);
