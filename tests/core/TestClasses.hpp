@@ -44,7 +44,10 @@ class SlowShutdown : public PhysicalObject {
 
 
 // A directory of the temporary folder, empty at first, removed at the end of the test.
-inline ScratchDirectory scratchDirectory(const std::string& name) { return ScratchDirectory("rp_core_test_", name); }
+// perProcess false: the same folder in a death test's child (see ScratchDirectory).
+inline ScratchDirectory scratchDirectory(const std::string& name, bool perProcess = true) {
+  return ScratchDirectory("rp_core_test_", name, perProcess);
+}
 
 inline void writeFile(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;

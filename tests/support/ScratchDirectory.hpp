@@ -14,9 +14,18 @@ namespace rp::test {
 
 class ScratchDirectory {
  public:
-  /// Creates (empty) `$TMPDIR/<prefix><name>_<pid>`.
-  ScratchDirectory(const std::string& prefix, const std::string& name)
-      : path_(std::filesystem::temp_directory_path() / (prefix + name + "_" + std::to_string(::getpid()))) {
+  /// Creates (empty) `$TMPDIR/<prefix><name>_<pid>`, or without `_<pid>` when `perProcess` is
+  /// false: for a death test, whose child (run again from the start of the test in gtest's
+  /// "threadsafe" style) then makes the same folder and exits without removing it, leaving that
+  /// to the parent's object.
+  ScratchDirectory(const std::string& prefix, const std::string& name, bool perProcess = true) {
+    std::string leaf = prefix;
+    leaf += name;
+    if (perProcess) {
+      leaf += '_';
+      leaf += std::to_string(::getpid());
+    }
+    path_ = std::filesystem::temp_directory_path() / leaf;
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }
