@@ -365,7 +365,8 @@ struct PinocchioArm {
       const LinkParameters& l = m.getLink(i);
       const pinocchio::SE3 a = se3(axis(i));
       const pinocchio::SE3 placement = parentAxis.actInv(a);
-      const std::string name = "j" + std::to_string(i);
+      std::string name = "j";  // (not "j" + ...: GCC 12's -Wrestrict false positive at -O3)
+      name += std::to_string(i);
       parent = m.isPrismatic(i) ? model.addJoint(parent, pinocchio::JointModelPZ(), placement, name)
                                 : model.addJoint(parent, pinocchio::JointModelRZ(), placement, name);
       model.appendBodyToJoint(parent, pinocchio::Inertia(l.mass, Eigen::Vector3d(l.com), Eigen::Matrix3d(l.inertia)),
