@@ -1,7 +1,9 @@
 // Kinematics and dynamics of the Puma 560 and the WAM 7, ours next to Orocos KDL's solvers
 // (ChainFkSolverPos_recursive, ChainJntToJacSolver, ChainIdSolver_RNE, ChainDynParam::JntToMass,
 // ChainFdSolver_RNE, ChainIkSolverPos_LMA), on the same 64 seeded random configurations; and ours
-// on the same two arms loaded from URDF (Arg 16 and 17: the Placement form next to DH).
+// on the same two arms loaded from URDF (Arg 16 and 17: the Placement form next to DH); and, when
+// built with Pinocchio (RP_HAVE_PINOCCHIO, see bench/CMakeLists.txt), Pinocchio's CRBA, RNEA and
+// ABA on the same arms.
 #include <benchmark/benchmark.h>
 
 #include <kdl/chaindynparam.hpp>
@@ -22,6 +24,14 @@
 
 #include "../tests/model/KdlChain.hpp"
 #include "rp/model/Model.hpp"
+
+#ifdef RP_HAVE_PINOCCHIO
+#include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/rnea.hpp>
+#include <pinocchio/multibody/data.hpp>
+#include <pinocchio/multibody/model.hpp>
+#endif
 
 namespace {
 
@@ -326,6 +336,96 @@ void Puma560ClosedFormIk_rp(benchmark::State& s) {
   }
 }
 BENCHMARK(Puma560ClosedFormIk_rp);
+
+#ifdef RP_HAVE_PINOCCHIO
+// Pinocchio's model of one of our arms (revolute and prismatic joints; no mimic joints), built from
+// our frames at q = 0: joint i turns (or slides) about z of its axis frame (frame i-1 in standard
+// DH, frame i otherwise), so its placement is the axis frame of joint i-1 to that of joint i, and
+// link i hangs on joint i at its link frame. Checked against our mass matrix when built.
+struct PinocchioArm {
+  pinocchio::Model model;
+  std::unique_ptr<pinocchio::Data> data;
+  std::vector<Eigen::VectorXd> q, qd, qdd;
+
+  explicit PinocchioArm(Robot& r) {
+    const ManipulatorModel& m = *r.model;
+    const int n = m.getNumberOfJoints();
+    ManipulatorData d(m);
+    forwardKinematics(m, d, JointVector::Zero(n));
+    auto se3 = [](const Transform& T) {
+      return pinocchio::SE3(Eigen::Matrix3d(T.topLeftCorner<3, 3>()), Eigen::Vector3d(T.topRightCorner<3, 1>()));
+    };
+    auto axis = [&](int i) -> Transform {
+      if (m.getConvention() != DHConvention::Standard) return d.linkTransforms[static_cast<std::size_t>(i)];
+      return i == 0 ? m.getBaseTransform() : d.linkTransforms[static_cast<std::size_t>(i - 1)];
+    };
+    pinocchio::JointIndex parent = 0;
+    pinocchio::SE3 parentAxis = pinocchio::SE3::Identity();
+    for (int i = 0; i < n; ++i) {
+      const LinkParameters& l = m.getLink(i);
+      const pinocchio::SE3 a = se3(axis(i));
+      const pinocchio::SE3 placement = parentAxis.actInv(a);
+      std::string name = "j";  // (not "j" + ...: GCC 12's -Wrestrict false positive at -O3)
+      name += std::to_string(i);
+      parent = m.isPrismatic(i) ? model.addJoint(parent, pinocchio::JointModelPZ(), placement, name)
+                                : model.addJoint(parent, pinocchio::JointModelRZ(), placement, name);
+      model.appendBodyToJoint(parent, pinocchio::Inertia(l.mass, Eigen::Vector3d(l.com), Eigen::Matrix3d(l.inertia)),
+                              a.actInv(se3(d.linkTransforms[static_cast<std::size_t>(i)])));
+      parentAxis = a;
+    }
+    model.gravity.linear(m.getGravity());
+    data = std::make_unique<pinocchio::Data>(model);
+    for (std::size_t k = 0; k < r.q.size(); ++k) {
+      q.emplace_back(r.q[k]);
+      qd.emplace_back(r.qd[k]);
+      qdd.emplace_back(r.qdd[k]);
+    }
+    // The same mass matrix as ours (Pinocchio fills the upper triangle).
+    double worst = 0;
+    for (std::size_t k = 0; k < q.size(); ++k) {
+      Eigen::MatrixXd M = pinocchio::crba(model, *data, q[k]);
+      M.triangularView<Eigen::StrictlyLower>() = M.transpose().triangularView<Eigen::StrictlyLower>();
+      const JointMatrix& ours = massMatrix(m, *r.data, r.q[k]);
+      worst = std::max(worst, (M - ours).cwiseAbs().maxCoeff() / ours.cwiseAbs().maxCoeff());
+    }
+    if (worst > 1e-12) {
+      std::fprintf(stderr, "model_bench: Pinocchio's %s differs from ours: mass matrix %.1e relative\n",
+                   m.getName().c_str(), worst);
+      std::exit(1);
+    }
+  }
+};
+PinocchioArm& pinocchioArm(const benchmark::State& s) {
+  static PinocchioArm pumaArm(puma()), wamArm(wam7());
+  return s.range(0) == 6 ? pumaArm : wamArm;
+}
+// range(1): 0 Pinocchio's default (Convention::LOCAL), 1 Convention::WORLD.
+void MassMatrix_Pinocchio(benchmark::State& s) {
+  PinocchioArm& p = pinocchioArm(s);
+  const auto convention = s.range(1) == 1 ? pinocchio::Convention::WORLD : pinocchio::Convention::LOCAL;
+  std::size_t k = 0;
+  for (auto _ : s) benchmark::DoNotOptimize(pinocchio::crba(p.model, *p.data, p.q[k++ & 63], convention).data());
+}
+// Newton-Euler (rnea) or, with forward, the articulated-body algorithm (aba) on the same states.
+template <bool forward>
+void pinocchioDynamics(benchmark::State& s) {
+  PinocchioArm& p = pinocchioArm(s);
+  std::size_t k = 0;
+  for (auto _ : s) {
+    const std::size_t i = k++ & 63;
+    if constexpr (forward) {
+      benchmark::DoNotOptimize(pinocchio::aba(p.model, *p.data, p.q[i], p.qd[i], p.qdd[i]).data());
+    } else {
+      benchmark::DoNotOptimize(pinocchio::rnea(p.model, *p.data, p.q[i], p.qd[i], p.qdd[i]).data());
+    }
+  }
+}
+void InverseDynamics_Pinocchio(benchmark::State& s) { pinocchioDynamics<false>(s); }
+void ForwardDynamics_Pinocchio(benchmark::State& s) { pinocchioDynamics<true>(s); }
+BENCHMARK(MassMatrix_Pinocchio)->Args({6, 0})->Args({6, 1})->Args({7, 0})->Args({7, 1});
+BENCHMARK(InverseDynamics_Pinocchio)->Arg(6)->Arg(7);
+BENCHMARK(ForwardDynamics_Pinocchio)->Arg(6)->Arg(7);
+#endif
 
 #define RP_PAIR(name)                              \
   BENCHMARK(name##_rp)->Arg(6)->Arg(7)->Arg(16)->Arg(17); \

@@ -28,13 +28,16 @@ const char* kUsage =
     "  --rate HZ        loop rate (default 1000)\n"
     "  --duration S     how long to run (default 10)\n"
     "  --priority P     SCHED_FIFO priority 1..99 (default 27, as in the paper; cyclictest -p P)\n"
-    "Compare with: cyclictest -m -p P -i 1000000/HZ -l HZ*S (interval in us)\n";
+    "  --affinity CPU   pin the loop thread to CPU (cyclictest -a CPU; default: not pinned)\n"
+    "Compare with: cyclictest -m -p P -i 1000000/HZ -l HZ*S [-a CPU] (interval in us), or run\n"
+    "bench/latency_vs_cyclictest.sh, which runs both and prints their p50, p99 and ratio\n";
 
-double number(const std::string& option, const char* text) {
+double number(const std::string& option, const char* text, bool zeroAllowed = false) {
   char* end = nullptr;
   const double v = text ? std::strtod(text, &end) : NAN;
-  if (!text || *end != '\0' || !std::isfinite(v) || v <= 0) {
-    std::cerr << "rp-latency: " << option << " needs a positive number\n" << kUsage;
+  if (!text || *end != '\0' || !std::isfinite(v) || v < 0 || (v == 0 && !zeroAllowed)) {
+    std::cerr << "rp-latency: " << option << (zeroAllowed ? " needs a number >= 0\n" : " needs a positive number\n")
+              << kUsage;
     std::exit(2);
   }
   return v;
@@ -46,13 +49,14 @@ int main(int argc, char** argv) {
   rp::RoboticPlatform::setGuiOff();
   rp::RoboticPlatform::init(argc, argv, kUsage);
   double rate = 1000, duration = 10;
-  int priority = 27;
+  int priority = 27, cpu = -1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const char* value = i + 1 < argc ? argv[i + 1] : nullptr;
     if (a == "--rate") rate = number(a, value), ++i;
     else if (a == "--duration") duration = number(a, value), ++i;
     else if (a == "--priority") priority = static_cast<int>(number(a, value)), ++i;
+    else if (a == "--affinity") cpu = static_cast<int>(number(a, value, true)), ++i;
     else {
       std::cerr << "rp-latency: unknown option '" << a << "'\n" << kUsage;
       return 2;
@@ -62,6 +66,7 @@ int main(int argc, char** argv) {
   try {
     loop.setRate(rate);
     loop.setPriority(priority);
+    loop.setCpuAffinity(cpu);
   } catch (const std::exception& e) {
     std::cerr << "rp-latency: " << e.what() << "\n";
     return 2;

@@ -217,28 +217,57 @@ using M3 = Eigen::Matrix3d;
 // inertia [Io, h^; h^T, m 1] is made of: the mass moment h = m c (c the centre of mass) and the
 // rotational inertia about the origin Io = R Ic R^T + m (|c|^2 1 - c c^T). With it, I (w; v) = (Io w + h x v; m v - h x w)
 // costs two 3x3 products instead of a 6x6 one, and inertias add as (m, h, Io).
+// Joint i's motion subspace S = (z; o x z) (revolute) or (0; z) (prismatic), with z and o the
+// axis and origin of its axis frame, from the last forward kinematics.
+inline void motionSubspace(const ManipulatorModel& model, const ManipulatorData& data, int i, double* S) {
+  const double* a = internal::axisFrame(model, data, i).data();  // column-major 4 x 4: z in 8..10, o in 12..14
+  const double zx = a[8], zy = a[9], zz = a[10];
+  if (model.getLink(i).type == JointType::Prismatic) {
+    S[0] = S[1] = S[2] = 0;
+    S[3] = zx, S[4] = zy, S[5] = zz;
+  } else {
+    const double ox = a[12], oy = a[13], oz = a[14];
+    S[0] = zx, S[1] = zy, S[2] = zz;
+    S[3] = oy * zz - oz * zy, S[4] = oz * zx - ox * zz, S[5] = ox * zy - oy * zx;
+  }
+}
+
+// Link i's mass moment h = m c and rotational inertia Io about the world origin, from its link
+// frame T (column-major 4 x 4). Io = R Ic R^T + m (|c|^2 1 - c c^T) is symmetric: only its six
+// distinct entries (xx, yy, zz, xy, xz, yz) are computed, from R Ic and six dot products, in plain
+// scalars (Eigen's products on the 3 x 3 corner of a 4 x 4 matrix took twice the instructions).
+[[gnu::always_inline]] inline void linkInertia(const LinkParameters& l, const Transform& T, double* h, double* Io) {
+  // Columns of four (the last row of T is 0 0 0 1) so that Eigen works on pairs of numbers.
+  using M43 = Eigen::Matrix<double, 4, 3>;
+  const auto R4 = T.leftCols<3>();
+  M43 A;
+  A.noalias() = R4 * l.inertia;                                // R Ic
+  // R Ic R^T: rows 0 and 1 (a pair each column), and the last diagonal entry.
+  Eigen::Matrix<double, 2, 3> J;
+  J.noalias() = A.topRows<2>() * T.topLeftCorner<3, 3>().transpose();
+  const double J22 = A.row(2).dot(T.block<1, 3>(2, 0));
+  const Eigen::Vector4d c = R4 * l.com + T.col(3);        // c(3) = 1
+  const double m = l.mass;
+  for (int a = 0; a < 3; ++a) h[a] = m * c(a);
+  const double hc = h[0] * c(0) + h[1] * c(1) + h[2] * c(2);
+  Io[0] = J(0, 0) + hc - h[0] * c(0);
+  Io[1] = J(1, 1) + hc - h[1] * c(1);
+  Io[2] = J22 + hc - h[2] * c(2);
+  Io[3] = J(0, 1) - h[0] * c(1);
+  Io[4] = J(0, 2) - h[0] * c(2);
+  Io[5] = J(1, 2) - h[1] * c(2);
+}
+
+// The six entries (xx, yy, zz, xy, xz, yz) as a symmetric 3 x 3 matrix.
+void symmetric(const double* s, M3& Io) { Io << s[0], s[3], s[4], s[3], s[1], s[5], s[4], s[5], s[2]; }
+
 void worldLinkInertias(const ManipulatorModel& model, ManipulatorData& data) {
   for (int i = 0; i < data.n; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    const LinkParameters& l = model.getLink(i);
-    const Transform& axis = internal::axisFrame(model, data, i);
-    const V3 z = axis.block<3, 1>(0, 2);
-    V6& S = data.motionSubspace[k];
-    if (l.type == JointType::Prismatic) {
-      S << 0, 0, 0, z;
-    } else {
-      S << z, V3(axis.topRightCorner<3, 1>()).cross(z);
-    }
-    const Transform& T = data.linkTransforms[k];
-    const M3 R = T.topLeftCorner<3, 3>();
-    const V3 c = R * V3(l.com) + V3(T.topRightCorner<3, 1>());
-    data.massMoment[k] = l.mass * c;
-    M3 RI;
-    RI.noalias() = R * M3(l.inertia);
-    M3& Io = data.originInertia[k];
-    Io.noalias() = RI * R.transpose();
-    Io.diagonal().array() += l.mass * c.squaredNorm();
-    Io.noalias() -= (l.mass * c) * c.transpose();
+    motionSubspace(model, data, i, data.motionSubspace[k].data());
+    double Io[6];
+    linkInertia(model.getLink(i), data.linkTransforms[k], data.massMoment[k].data(), Io);
+    symmetric(Io, data.originInertia[k]);
   }
 }
 
@@ -257,27 +286,48 @@ void worldSpatialInertias(const ManipulatorModel& model, ManipulatorData& data) 
   }
 }
 
-// The composite-rigid-body algorithm on those quantities: with (m, h, Io) summed over links j..n
-// (the inertia I^c_j), F_j = I^c_j S_j and M_ij = S_i . F_j for i <= j.
+// The composite-rigid-body algorithm on those quantities, in one pass from the tip: link j's
+// (m, h, Io) are added to those of links j+1..n (the composite inertia I^c_j, its rotational part as
+// the six numbers of a symmetric matrix), F_j = I^c_j S_j is kept, and row j of M is M_jk = S_j . F_k
+// for k >= j (the columns of the links beyond j are already known). No 6 x 6 matrix is formed and
+// everything is in scalars. With keepLinks, each link's h and Io and each S_j are kept in data for
+// the velocity products of forwardDynamics().
+template <bool keepLinks>
 void compositeRigidBody(const ManipulatorModel& model, ManipulatorData& data, bool motorInertia) {
-  double m = 0;
-  V3 h = V3::Zero();
-  M3 Io = M3::Zero();
-  for (int j = data.n - 1; j >= 0; --j) {
+  const int n = data.n;
+  double* M = data.massMatrix.data();
+  const Eigen::Index ld = data.massMatrix.rows();  // column-major
+  double m = 0, hx = 0, hy = 0, hz = 0;
+  double xx = 0, yy = 0, zz = 0, xy = 0, xz = 0, yz = 0;  // I^c_j's rotational part about the origin
+  for (int j = n - 1; j >= 0; --j) {
     const auto k = static_cast<std::size_t>(j);
-    m += model.getLink(j).mass;
-    h += data.massMoment[k];
-    Io += data.originInertia[k];
-    const V6& S = data.motionSubspace[k];
-    const V3 sw = S.head<3>(), sv = S.tail<3>();
-    const V3 Fn = Io * sw + h.cross(sv), Ff = m * sv - h.cross(sw);
-    for (int i = 0; i <= j; ++i) {
-      const V6& Si = data.motionSubspace[static_cast<std::size_t>(i)];
-      const double Mij = Si.head<3>().dot(Fn) + Si.tail<3>().dot(Ff);
-      data.massMatrix(i, j) = Mij;
-      data.massMatrix(j, i) = Mij;
+    const LinkParameters& l = model.getLink(j);
+    double h[3], Io[6];
+    linkInertia(l, data.linkTransforms[k], h, Io);
+    if constexpr (keepLinks) {
+      data.massMoment[k] << h[0], h[1], h[2];
+      symmetric(Io, data.originInertia[k]);
     }
-    if (motorInertia) data.massMatrix(j, j) += model.getArmatureInertia()(j);
+    m += l.mass;
+    hx += h[0], hy += h[1], hz += h[2];
+    xx += Io[0], yy += Io[1], zz += Io[2], xy += Io[3], xz += Io[4], yz += Io[5];
+    double* S = data.motionSubspace[k].data();
+    motionSubspace(model, data, j, S);
+    // F = (Io sw + h x sv; m sv - h x sw)
+    double* F = data.inertiaTimesS[k].data();
+    F[0] = xx * S[0] + xy * S[1] + xz * S[2] + (hy * S[5] - hz * S[4]);
+    F[1] = xy * S[0] + yy * S[1] + yz * S[2] + (hz * S[3] - hx * S[5]);
+    F[2] = xz * S[0] + yz * S[1] + zz * S[2] + (hx * S[4] - hy * S[3]);
+    F[3] = m * S[3] - (hy * S[2] - hz * S[1]);
+    F[4] = m * S[4] - (hz * S[0] - hx * S[2]);
+    F[5] = m * S[5] - (hx * S[1] - hy * S[0]);
+    const V6& Sj = data.motionSubspace[k];
+    for (int c = j; c < n; ++c) {
+      const double Mjc = Sj.dot(data.inertiaTimesS[static_cast<std::size_t>(c)]);
+      M[j + c * ld] = Mjc;
+      M[c + j * ld] = Mjc;
+    }
+    if (motorInertia) M[j + j * ld] += model.getArmatureInertia()(j);
   }
 }
 
@@ -378,14 +428,13 @@ const JointVector& coupledForwardDynamics(const ManipulatorModel& model, Manipul
   } else {
     c.bias.setZero();
   }
-  worldLinkInertias(chain, c);
+  compositeRigidBody<true>(chain, c, options.motorInertia);  // also the link inertias of the velocity products
   velocityProductTorques(chain, c, data.chainQd, options.tipWrench, c.scratchTau);
   for (int k = 0; k < c.n; ++k) {
     double h = c.bias(k) + c.scratchTau(k);
     if (options.friction) h += jointFriction(chain.getLink(k), data.chainQd(k));
     c.bias(k) = h;
   }
-  compositeRigidBody(chain, c, options.motorInertia);
   massFromChain(model, data);
   internal::torqueFromChain(model, c.bias, data.bias);
   for (int i = 0; i < data.n; ++i) data.qdd(i) = tau(i) - data.bias(i);
@@ -405,8 +454,7 @@ const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& da
     return data.massMatrix;
   }
   forwardKinematics(model, data, q);
-  worldLinkInertias(model, data);
-  compositeRigidBody(model, data, motorInertia);
+  compositeRigidBody<false>(model, data, motorInertia);
   return data.massMatrix;
 }
 
@@ -420,7 +468,7 @@ const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorDat
   } else {
     data.bias.setZero();
   }
-  worldLinkInertias(model, data);
+  compositeRigidBody<true>(model, data, options.motorInertia);  // also the link inertias of the velocity products
   velocityProductTorques(model, data, qd, options.tipWrench, data.scratchTau);
   for (int i = 0; i < data.n; ++i) {
     double h = data.bias(i) + data.scratchTau(i);
@@ -428,7 +476,6 @@ const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorDat
     data.bias(i) = h;
     data.qdd(i) = tau(i) - h;
   }
-  compositeRigidBody(model, data, options.motorInertia);
   ldlSolveInPlace(data, data.qdd);
   return data.qdd;
 }

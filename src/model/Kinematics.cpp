@@ -17,12 +17,35 @@ const Transform& forwardKinematics(const ManipulatorModel& model, ManipulatorDat
   }
   // T_i = T_{i-1} A_i on the affine part only (the last row of a transform is constant).
   const Transform* previous = &model.getBaseTransform();
+  const bool standard = model.getConvention() == DHConvention::Standard;
   for (int i = 0; i < data.n; ++i) {
-    Eigen::Matrix<double, 3, 4> A;
-    internal::linkMatrix(model, i, q(i), A);
     Transform& T = data.linkTransforms[static_cast<std::size_t>(i)];
-    T.topRows<3>().noalias() = previous->topLeftCorner<3, 3>() * A;
-    T.topRightCorner<3, 1>() += previous->topRightCorner<3, 1>();
+    if (standard) {
+      // A_i = Rz(theta) Tz(d) Tx(a) Rx(alpha) applied to T_{i-1}'s columns x, y, z, p: with
+      // x' = ct x + st y and y' = ct y - st x, T_i = (x', ca y' + sa z, ca z - sa y', p + a x' + d z):
+      // 30 multiplications instead of the 36 of a 3 x 3 by 3 x 4 product and the 6 of A_i.
+      const LinkParameters& l = model.getLink(i);
+      const bool prismatic = l.type == JointType::Prismatic;
+      const double theta = prismatic ? l.offset : q(i) + l.offset;
+      const double d = prismatic ? l.d + q(i) : l.d;
+      const double ct = std::cos(theta), st = std::sin(theta);
+      const double ca = model.getCosAlpha()(i), sa = model.getSinAlpha()(i), a = l.a;
+      const double* P = previous->data();  // column-major 4 x 4
+      double* t = T.data();
+      for (int r = 0; r < 3; ++r) {
+        const double x = P[r], y = P[r + 4], z = P[r + 8];
+        const double x1 = ct * x + st * y, y1 = ct * y - st * x;
+        t[r] = x1;
+        t[r + 4] = ca * y1 + sa * z;
+        t[r + 8] = ca * z - sa * y1;
+        t[r + 12] = P[r + 12] + a * x1 + d * z;
+      }
+    } else {
+      Eigen::Matrix<double, 3, 4> A;
+      internal::linkMatrix(model, i, q(i), A);
+      T.topRows<3>().noalias() = previous->topLeftCorner<3, 3>() * A;
+      T.topRightCorner<3, 1>() += previous->topRightCorner<3, 1>();
+    }
     T.row(3) << 0, 0, 0, 1;
     previous = &T;
   }

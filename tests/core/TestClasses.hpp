@@ -7,6 +7,7 @@
 #include <string>
 #include <unistd.h>
 
+#include "ScratchDirectory.hpp"
 #include "rp/core/Core.hpp"
 
 namespace rp::test {
@@ -42,12 +43,10 @@ class SlowShutdown : public PhysicalObject {
 };
 
 
-// A directory under the build tree, emptied for each use.
-inline std::filesystem::path scratchDirectory(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("rp_core_test_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+// A directory of the temporary folder, empty at first, removed at the end of the test.
+// perProcess false: the same folder in a death test's child (see ScratchDirectory).
+inline ScratchDirectory scratchDirectory(const std::string& name, bool perProcess = true) {
+  return ScratchDirectory("rp_core_test_", name, perProcess);
 }
 
 inline void writeFile(const std::filesystem::path& path, const std::string& text) {

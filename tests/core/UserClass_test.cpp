@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -18,7 +19,7 @@ class UserClassTest : public ::testing::Test {
  protected:
   void SetUp() override {
     RoboticPlatform::setSimulationModeOn();
-    file_ = "/tmp/rp_user_class_" + std::to_string(::getpid()) + ".cfg";
+    file_ = (std::filesystem::temp_directory_path() / ("rp_user_class_" + std::to_string(::getpid()) + ".cfg")).string();
   }
   void TearDown() override {
     ObjectManager().deleteAllObjects();

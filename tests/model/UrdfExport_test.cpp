@@ -18,6 +18,7 @@
 #include "rp/model/UrdfExport.hpp"
 #include "rp/model/UrdfModel.hpp"
 #include "rp/model/WAMModel.hpp"
+#include "ScratchDirectory.hpp"
 
 namespace rp {
 namespace {
@@ -167,7 +168,7 @@ void checkNamesKept(const std::string& file, const std::string& tip) {
   EXPECT_EQ(exported->getJoint("tool")->parent_link_name, parent);
   EXPECT_EQ(exported->joints_.size(), static_cast<std::size_t>(n + 2));  // and the fixed base and tool joints
 
-  const std::string path = testing::TempDir() + "/names_kept_" + file;
+  const test::ScratchFile path("names_kept_" + file);
   std::ofstream(path) << xml;
   UrdfOptions again;
   again.tip = "tool";
@@ -278,7 +279,7 @@ TEST(UrdfExport, PumaReloadedFromItsExportIsTheSameArmAsFarAsUrdfGoes) {
   const Puma560Model puma;
   const PhysicalModel exported = physicalModel(puma);
   const ManipulatorModel& physical = exported.model;
-  const std::string file = testing::TempDir() + "/puma560_export_reload.urdf";
+  const test::ScratchFile file("puma560_export_reload.urdf");
   std::ofstream(file) << toUrdf(puma);
   UrdfOptions options;
   options.tip = "tool";

@@ -33,6 +33,7 @@
 #include "rp/model/UrdfExport.hpp"
 #include "UrdfDom.hpp"
 #include "rp/model/UrdfModel.hpp"
+#include "ScratchDirectory.hpp"
 
 namespace rp {
 namespace {
@@ -186,7 +187,7 @@ TEST(UrdfModel, ExportedPrismaticAndModifiedDhArmsLoadBack) {
   const std::unique_ptr<ManipulatorModel> mdh = test::toModifiedDh(Puma560Model());
   for (const ManipulatorModel* model : {arm.get(), mdh.get()}) {
     const std::string text = toUrdf(*model);
-    const std::string file = testing::TempDir() + "/" + model->getName() + "_roundtrip.urdf";
+    const test::ScratchFile file(model->getName() + "_roundtrip.urdf");
     std::ofstream(file) << text;
     const std::unique_ptr<ManipulatorModel> back = loadUrdf(file, options);
     ASSERT_EQ(back->getNumberOfJoints(), model->getNumberOfJoints());
@@ -213,7 +214,7 @@ TEST(UrdfModel, ExportedPrismaticAndModifiedDhArmsLoadBack) {
 
 TEST(UrdfModel, ExportedPumaLoadsBackWithTheSameKinematicsAndDynamics) {
   const Puma560Model puma;
-  const std::string file = testing::TempDir() + "/puma560_roundtrip.urdf";
+  const test::ScratchFile file("puma560_roundtrip.urdf");
   std::ofstream(file) << toUrdf(puma);
   UrdfOptions options;
   options.tip = "tool";
@@ -332,13 +333,13 @@ TEST(UrdfModel, MovingLinksOffTheChainAreLumpedAtTheStatedConfiguration) {
     s << in.rdbuf();
     return s.str();
   }();
-  auto variant = [&](const std::string& from, const std::string& to) {
+  const test::ScratchFile file("panda_variant.urdf");
+  auto variant = [&](const std::string& from, const std::string& to) -> std::string {
     std::string t = text;
     const std::size_t at = t.find(from);
     EXPECT_NE(at, std::string::npos) << from;
     t.replace(at, from.size(), to);
-    const std::string file = testing::TempDir() + "/panda_variant.urdf";
-    std::ofstream(file) << t;
+    std::ofstream(file.path()) << t;
     return file;
   };
   auto error = [](const std::string& file, const std::string& tip = "") -> std::string {
@@ -433,13 +434,13 @@ TEST(UrdfModel, MimicJointOnTheChainNamingAMissingJointIsRefused) {
   std::ifstream in(kData + "/mimic_arm.urdf");
   std::stringstream text;
   text << in.rdbuf();
-  auto variant = [&](const std::string& from, const std::string& to) {
+  const test::ScratchFile file("mimic_variant.urdf");
+  auto variant = [&](const std::string& from, const std::string& to) -> std::string {
     std::string t = text.str();
     const std::size_t at = t.find(from);
     EXPECT_NE(at, std::string::npos) << from;
     t.replace(at, from.size(), to);
-    const std::string file = testing::TempDir() + "/mimic_variant.urdf";
-    std::ofstream(file) << t;
+    std::ofstream(file.path()) << t;
     return file;
   };
   auto error = [](const std::string& file) -> std::string {

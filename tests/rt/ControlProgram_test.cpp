@@ -16,16 +16,12 @@
 #include "rp/core/PhysicalObject.hpp"
 #include "rp/rt/Clock.hpp"
 #include "rp/rt/LogWriter.hpp"
+#include "ScratchDirectory.hpp"
 
 namespace rp {
 namespace {
 
-std::filesystem::path scratch(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("rp_rt_test_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+test::ScratchDirectory scratch(const std::string& name) { return test::ScratchDirectory("rp_rt_test_", name); }
 
 std::vector<std::string> lines(const std::filesystem::path& path) {
   std::vector<std::string> out;

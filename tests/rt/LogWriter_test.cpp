@@ -30,18 +30,14 @@
 #include "rp/rt/Clock.hpp"
 #include "rp/rt/ControlProgram.hpp"
 #include "rp/rt/LogRecovery.hpp"
+#include "ScratchDirectory.hpp"
 
 namespace rp {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
-  auto dir = fs::temp_directory_path() / ("rp_log_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+test::ScratchDirectory scratch(const std::string& name) { return test::ScratchDirectory("rp_log_test_", name); }
 
 std::string slurp(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

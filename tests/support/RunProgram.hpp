@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -26,13 +27,16 @@ inline std::string slurp(const std::string& path) {
   return ss.str();
 }
 
-// Runs `command` (a shell command line) with stdout and stderr to `base`.out and `base`.err.
+// Runs `command` (a shell command line) with stdout and stderr to `base`.out and `base`.err,
+// which are removed again once read.
 inline Outcome runProgram(const std::string& command, const std::string& base) {
   const int raw = std::system((command + " >" + base + ".out 2>" + base + ".err").c_str());
   Outcome r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   r.out = slurp(base + ".out");
   r.err = slurp(base + ".err");
+  std::remove((base + ".out").c_str());
+  std::remove((base + ".err").c_str());
   return r;
 }
 

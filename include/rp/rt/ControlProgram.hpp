@@ -136,6 +136,15 @@ class ControlProgram {
   void setPriority(int priority);
   /// The SCHED_FIFO priority.
   int getPriority() const;
+  /// Pins the loop thread to one CPU on the real clock (like cyclictest's `-a CPU`); -1 (the
+  /// default) leaves it where the scheduler puts it. A CPU the process may not use is reported
+  /// once on stderr and the loop runs unpinned.
+  /// @param[in] cpu  a CPU number (0 .. the number of CPUs - 1), or -1
+  /// @throws std::invalid_argument if below -1
+  /// @throws std::logic_error if running
+  void setCpuAffinity(int cpu);
+  /// The CPU the loop thread is pinned to, or -1.
+  int getCpuAffinity() const;
   /// Runs the program on `clock` (default: RoboticPlatform::getDefaultClock()).
   /// @param[in] clock  a clock that outlives the program's run
   void setClock(Clock& clock);
