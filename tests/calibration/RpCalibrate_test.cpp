@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <random>
@@ -36,6 +37,7 @@
 
 #include "Calibration.hpp"
 #include "RunProgram.hpp"
+#include "ScratchDirectory.hpp"
 #include "rp/manipulator/ManipulatorSimulation.hpp"
 #include "rp/model/Model.hpp"
 
@@ -54,7 +56,9 @@ Outcome run(const std::string& args, const std::string& config = "") {
     std::ofstream(base + ".cfg") << config;
     command += " -config " + base + ".cfg";
   }
-  return test::runProgram(command + " " + args, base);
+  Outcome r = test::runProgram(command + " " + args, base);
+  std::remove((base + ".cfg").c_str());
+  return r;
 }
 
 constexpr double kDeg = M_PI / 180;
@@ -103,7 +107,8 @@ TEST(RpCalibrate, RecoversThePumasEncoderOffsetsAndFriction) {
       "simEncoderOffset 0.3 0.3 -0.25 0.4 0.3 0.2\n"
       "simFrictionScale 1 1.3 0.8 1.2 1 1\n"
       "simCountsPerRadian 100000\n";
-  const Outcome r = run("--json --write " + tempPath("written.cfg"), config);
+  const test::ScratchFile writtenFile("rp_calibrate_" + std::to_string(::getpid()) + "_written.cfg");  // removed at the end
+  const Outcome r = run("--json --write " + writtenFile.path(), config);
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json out = nlohmann::json::parse(r.out);
   EXPECT_EQ(out.at("arm"), "puma");
@@ -150,7 +155,7 @@ TEST(RpCalibrate, RecoversThePumasEncoderOffsetsAndFriction) {
   for (const auto& b : out.at("gravity").at("base"))
     expectRecovered(b, b.at("nominal").get<double>(), 0.02, b.at("expression").get<std::string>());
   // What rp.cfg can take of it, and the reasons for the rest.
-  const std::string written = slurp(tempPath("written.cfg"));
+  const std::string written = slurp(writtenFile.path());
   EXPECT_NE(written.find("[puma]\nclass Puma560\n"), std::string::npos) << written;
   EXPECT_NE(written.find("simFrictionScale 1"), std::string::npos) << written;
   EXPECT_NE(written.find("simEncoderOffset 0 0.3"), std::string::npos) << written;
