@@ -17,6 +17,7 @@
 #include "rp/model/Kinematics.hpp"
 #include "rp/rt/Clock.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
+#include "../model/ChainInternal.hpp"
 #include "LinkShapes.hpp"
 #include "PayloadHandover.hpp"
 
@@ -1017,7 +1018,10 @@ void DefaultManipulator::gravityWithPayload() {
   if (payloadMass_ == 0) return;
   // The weight W = m g at the centre p: the torque that holds it is -J_p^T W, J_p's columns the
   // end-effector's (Jv_j + Jw_j x (p - e)).
-  const Jacobian& J = jacobian(*model_, *data_, q_, ReferenceFrame::Base);
+  // gravityTorque() above left the forward kinematics of q_ in data_: the Jacobian from them,
+  // without computing them again in this cycle.
+  internal::jacobianFromKinematics(*model_, *data_);
+  const Jacobian& J = data_->jacobian;
   const Transform& e = data_->endEffector;
   const Eigen::Vector3d r = e.topLeftCorner<3, 3>() * Eigen::Vector3d(payloadCentre_);
   const Eigen::Vector3d weight = payloadMass_ * Eigen::Vector3d(model_->getGravity());
