@@ -147,7 +147,7 @@ def line_pattern(doc_line, placeholders=False):
         elif re.fullmatch(r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?", token or "x"):
             pattern += r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
         else:
-            pattern += re.sub(r"\\ ", r"\\s+", re.escape(token))
+            pattern += re.sub(r"(?:\\ )+", r"\\s+", re.escape(token))
     return re.compile(pattern)
 
 
