@@ -40,6 +40,30 @@ const Transform& forwardKinematics(const ManipulatorModel& model, ManipulatorDat
         t[r + 8] = ca * z - sa * y1;
         t[r + 12] = P[r + 12] + a * x1 + d * z;
       }
+    } else if (const PlacementAxes& ax = model.getPlacementAxes(i); ax.permutation) {
+      // P_i's rotation only permutes and flips axes: T_{i-1} P_i's columns are T_{i-1}'s own,
+      // (s0 c_a0, s1 c_a1, s2 c_a2, p + R p_i), then Rz(q) or Tz(q): at most 9 + 15 multiplications
+      // instead of 48.
+      const Transform& Pl = model.getPlacement(i);
+      const double* P = previous->data();  // column-major 4 x 4
+      const Eigen::Vector3d p = previous->topRightCorner<3, 1>() + previous->topLeftCorner<3, 3>() * Pl.topRightCorner<3, 1>();
+      const Eigen::Map<const Eigen::Vector3d> x(P + 4 * ax.axis[0]), y(P + 4 * ax.axis[1]), z(P + 4 * ax.axis[2]);
+      if (model.isPrismatic(i)) {
+        const Eigen::Vector3d zs = ax.sign[2] * z;
+        T.block<3, 1>(0, 0) = ax.sign[0] * x;
+        T.block<3, 1>(0, 1) = ax.sign[1] * y;
+        T.block<3, 1>(0, 3) = p + q(i) * zs;
+        T.block<3, 1>(0, 2) = zs;
+      } else {
+        // x' = c x + s y, y' = c y - s x with x = s0 c_a0, y = s1 c_a1.
+        const double c = std::cos(q(i)), s = std::sin(q(i));
+        const double cx = c * ax.sign[0], sx = s * ax.sign[0], cy = c * ax.sign[1], sy = s * ax.sign[1];
+        const Eigen::Vector3d x1 = cx * x + sy * y, y1 = cy * y - sx * x, z1 = ax.sign[2] * z;
+        T.block<3, 1>(0, 0) = x1;
+        T.block<3, 1>(0, 1) = y1;
+        T.block<3, 1>(0, 2) = z1;
+        T.block<3, 1>(0, 3) = p;
+      }
     } else {
       Eigen::Matrix<double, 3, 4> A;
       internal::linkMatrix(model, i, q(i), A);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -33,6 +34,27 @@ Transform modifiedPlacement(const LinkParameters& l) {
   return P;
 }
 
+// The rotation of `P` as a signed permutation of the axes, if every entry is 0 or +-1 to within
+// 8 machine epsilons (cos(pi/2) is 6e-17, not 0) with one +-1 in each column.
+PlacementAxes signedPermutation(const Transform& P) {
+  constexpr double kTolerance = 8 * std::numeric_limits<double>::epsilon();
+  PlacementAxes axes;
+  for (int k = 0; k < 3; ++k) {
+    int found = -1;
+    for (int r = 0; r < 3; ++r) {
+      const double v = P(r, k);
+      if (std::abs(v) <= kTolerance) continue;
+      if (found >= 0 || std::abs(std::abs(v) - 1) > kTolerance) return PlacementAxes{};
+      found = r;
+      axes.sign[static_cast<std::size_t>(k)] = v > 0 ? 1.0 : -1.0;
+    }
+    if (found < 0) return PlacementAxes{};
+    axes.axis[static_cast<std::size_t>(k)] = found;
+  }
+  axes.permutation = true;  // a rigid transform's rotation: the three columns are distinct axes
+  return axes;
+}
+
 }  // namespace
 
 ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters> links, const Transform& base,
@@ -52,6 +74,7 @@ ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters>
   if (!base_.allFinite() || !tool_.allFinite() || !gravity_.allFinite())
     throw std::invalid_argument("ManipulatorModel '" + name_ + "': the base, tool or gravity is not finite");
   placements_.assign(static_cast<std::size_t>(n), Transform::unit());
+  placementAxes_.assign(static_cast<std::size_t>(n), PlacementAxes{});
   std::unordered_set<std::string> jointNames, linkNames;
   for (int i = 0; i < n; ++i) {
     LinkParameters& l = links_[static_cast<std::size_t>(i)];
@@ -78,6 +101,7 @@ ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters>
         throw std::invalid_argument(joint + "a placement given with DH parameters (use DHConvention::Placement)");
       if (convention_ == DHConvention::Modified) placements_[static_cast<std::size_t>(i)] = modifiedPlacement(l);
     }
+    placementAxes_[static_cast<std::size_t>(i)] = signedPermutation(placements_[static_cast<std::size_t>(i)]);
     if (l.mass < 0) throw std::invalid_argument(joint + "negative mass");
     if (!(l.positionMin <= l.positionMax)) throw std::invalid_argument(joint + "position limits have min > max");
     if (!(l.velocityLimit > 0) || !(l.accelerationLimit > 0) || !(l.jerkLimit > 0) || !(l.torqueLimit > 0)) {

@@ -4,6 +4,7 @@
 // paths for the two conventions). KDL agreement is in Kdl_test.cpp.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -154,6 +155,82 @@ TEST(ManipulatorModel, PlacementFormIsCheckedAndKeepsNames) {
   bad = links;
   bad[5].linkName = "body1";
   EXPECT_EQ(refused(bad, DHConvention::Placement), "ManipulatorModel 'bad' joint 6 ('j5'): a second link named 'body1'");
+}
+
+// Placements turned by multiples of 90 degrees (every signed permutation with determinant +1, as
+// rpy = (pi/2, 0, 0) gives them with cos(pi/2) = 6e-17) take the kinematics' short path; a
+// placement turned by 4e-8 rad does not. Both agree with the product of the 4 x 4 matrices
+// P_i Rz(q_i) or P_i Tz(q_i) to rounding.
+TEST(ManipulatorModel, QuarterTurnPlacementsAreSignedPermutationsAndComputeAsTheProduct) {
+  std::vector<Eigen::Matrix3d> rotations;
+  for (int x = 0; x < 3; ++x)
+    for (int y = 0; y < 3; ++y) {
+      if (y == x) continue;
+      for (double sx : {-1.0, 1.0})
+        for (double sy : {-1.0, 1.0}) {
+          Eigen::Matrix3d R = Eigen::Matrix3d::Zero();
+          R(x, 0) = sx;
+          R(y, 1) = sy;
+          R.col(2) = Eigen::Vector3d(R.col(0)).cross(Eigen::Vector3d(R.col(1)));
+          rotations.push_back(R);
+        }
+    }
+  ASSERT_EQ(rotations.size(), 24u);
+  // rpy = (pi/2, 0, 0) as a URDF loader computes it, and a turn of 4e-8 rad about z.
+  rotations.push_back(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix());
+  rotations.push_back(Eigen::AngleAxisd(4e-8, Eigen::Vector3d::UnitZ()).toRotationMatrix());
+  ASSERT_NE(rotations[24](1, 1), 0.0) << "cos(pi/2) in double is not 0";
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (std::size_t first : {std::size_t{0}, std::size_t{13}}) {  // two arms of 13 links (a model has at most 16)
+    std::vector<LinkParameters> links;
+    for (std::size_t k = first; k < first + 13; ++k) {
+      LinkParameters l;
+      l.placement.topLeftCorner<3, 3>() = rotations[k];
+      l.placement.topRightCorner<3, 1>() = Eigen::Vector3d(u(rng), u(rng), u(rng));
+      if (k % 3 == 1) {
+        l.type = JointType::Prismatic;
+        l.positionMin = -1;
+        l.positionMax = 1;
+      }
+      links.push_back(l);
+    }
+    const ManipulatorModel model("turns", links, Transform::unit(), Transform::unit(), ManipulatorModel::standardGravity(),
+                                 DHConvention::Placement);
+    for (int i = 0; i < 13; ++i) {
+      const std::size_t k = first + static_cast<std::size_t>(i);
+      const PlacementAxes& ax = model.getPlacementAxes(i);
+      if (k == 25) {
+        EXPECT_FALSE(ax.permutation);
+        continue;
+      }
+      ASSERT_TRUE(ax.permutation) << k;
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(std::round(rotations[k](ax.axis[c], c)), ax.sign[c]) << k;
+      if (k == 24) {
+        EXPECT_EQ(ax.axis, (std::array<int, 3>{0, 2, 1}));
+        EXPECT_EQ(ax.sign, (std::array<double, 3>{1, 1, -1}));
+      }
+    }
+    ManipulatorData data(model);
+    const int n = model.getNumberOfJoints();
+    for (int trial = 0; trial < 50; ++trial) {
+      JointVector q(n);
+      for (int i = 0; i < n; ++i) q(i) = 3 * u(rng);
+      Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+      forwardKinematics(model, data, q);
+      for (int i = 0; i < n; ++i) {
+        Eigen::Matrix4d J = Eigen::Matrix4d::Identity();
+        if (model.isPrismatic(i)) {
+          J(2, 3) = q(i);
+        } else {
+          J.topLeftCorner<3, 3>() = Eigen::AngleAxisd(q(i), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+        }
+        T = T * Eigen::Matrix4d(links[static_cast<std::size_t>(i)].placement) * J;
+        ASSERT_LT(maxDiff(data.linkTransforms[static_cast<std::size_t>(i)], T), 1e-13)
+            << "link " << first + i << ", trial " << trial;
+      }
+    }
+  }
 }
 
 }  // namespace

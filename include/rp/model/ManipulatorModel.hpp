@@ -3,6 +3,7 @@
 /// The constant description of a serial manipulator: kinematics (Denavit-Hartenberg or general
 /// placements), dynamics, drive train and limits (paper section 3.3, Figure 7).
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -97,6 +98,16 @@ struct JointCoupling {
   bool mimic = false;     ///< true: a mimic joint, no joint of the model; false: model joint `joint` itself
 };
 
+/// The rotation of a link's fixed placement when it only permutes and flips axes, as a placement
+/// whose roll, pitch and yaw are multiples of 90 degrees does (every entry 0 or +-1 to within
+/// 8 machine epsilons): column k of the rotation is `sign[k]` times unit vector `axis[k]`. The
+/// kinematics then moves the previous frame's columns instead of multiplying by the rotation.
+struct PlacementAxes {
+  bool permutation = false;            ///< whether the rotation is such a signed permutation
+  std::array<int, 3> axis{0, 1, 2};     ///< the unit vector (0 x, 1 y, 2 z) of column k
+  std::array<double, 3> sign{1, 1, 1};  ///< its sign (+1 or -1)
+};
+
 /// The constant model of a serial manipulator with revolute and prismatic joints: Denavit-Hartenberg
 /// (standard or modified) or general-placement (DHConvention::Placement) kinematics, rigid-body
 /// dynamics, motor inertia, friction and limits, a base transform (the
@@ -168,6 +179,9 @@ class ManipulatorModel {
   /// standard DH, whose fixed parts lie on both sides of the motion, the unit transform.
   /// Real-time safe: yes.
   const Transform& getPlacement(int i) const { return placements_[static_cast<std::size_t>(i)]; }
+  /// The rotation of getPlacement(i) as a signed permutation of the axes, when it is one (see
+  /// PlacementAxes; modified DH and Placement conventions). Real-time safe: yes.
+  const PlacementAxes& getPlacementAxes(int i) const { return placementAxes_[static_cast<std::size_t>(i)]; }
   /// Whether joint `i` (from 0) is prismatic. Real-time safe: yes.
   bool isPrismatic(int i) const { return getLink(i).type == JointType::Prismatic; }
   /// Pose of the base in the world [m]. Real-time safe: yes.
@@ -230,6 +244,7 @@ class ManipulatorModel {
   Vector<3> gravity_;
   DHConvention convention_;
   std::vector<Transform> placements_;
+  std::vector<PlacementAxes> placementAxes_;
   JointVector qmin_, qmax_, vmax_, amax_, jmax_, taumax_, armature_, home_, cosAlpha_, sinAlpha_;
   std::shared_ptr<const ManipulatorModel> chain_;  // with mimic joints only
   std::vector<JointCoupling> coupling_;
