@@ -1,8 +1,11 @@
-// How many simulated Puma 560 arms one core runs at 1 kHz in real time.
+// How many simulated Puma 560 arms one core runs at 1 kHz in real time, in both thread modes:
+// `shared` (the default: one executor thread steps every arm in its read, control and write
+// phases) and `own` (a thread per arm, rp.cfg `thread own`); --mode shared|own|both (default both)
+// chooses, each mode searched in turn in the same run.
 //
-// The whole process is pinned to one CPU (--cpu, default 1), so every arm's servo thread shares
-// that core. Each arm is a Puma560 in simulation mode on the real clock: its own ControlProgram
-// thread (SCHED_FIFO priority 27 when permitted) runs the full servo cycle every 1 ms - a
+// The whole process is pinned to one CPU (--cpu, default 1), so every servo thread shares that
+// core. Each arm is a Puma560 in simulation mode on the real clock: its ControlProgram (SCHED_FIFO
+// priority 27 when permitted) runs the full servo cycle every 1 ms - a
 // setpoint from a trajectory generator (a slow sinusoid on joints 1-3), DefaultPositionControl
 // with gravity compensation, the limit checks, the forward dynamics and integration of the
 // simulation step, the lock-free state publication. For a number of arms N the program runs all
@@ -20,7 +23,9 @@
 // the limit), and cpu_us_per_arm_cycle the process's CPU time per arm cycle (cycle, thread
 // switch and timer wake-up).
 //
-// Usage: arms_per_core [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
+// Each mode's result line begins `arms_per_core MODE N ...`.
+//
+// Usage: arms_per_core [--mode M] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
 #include <sched.h>
 #include <sys/resource.h>
 
@@ -149,6 +154,7 @@ Trial attempt(int n, double seconds, int tries) {
 int main(int argc, char** argv) {
   int cpu = 1, start = 16, max = 4096, resolution = 4, tries = 3;
   double seconds = 5;
+  std::string mode = "both";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> const char* {
@@ -158,7 +164,13 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--cpu") {
+    if (a == "--mode") {
+      mode = value();
+      if (mode != "shared" && mode != "own" && mode != "both") {
+        std::fprintf(stderr, "arms_per_core: --mode must be shared, own or both\n");
+        return 2;
+      }
+    } else if (a == "--cpu") {
       cpu = std::atoi(value());
     } else if (a == "--seconds") {
       seconds = std::atof(value());
@@ -172,7 +184,7 @@ int main(int argc, char** argv) {
       resolution = std::max(1, std::atoi(value()));
     } else {
       std::fprintf(stderr,
-                   "usage: arms_per_core [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
+                   "usage: arms_per_core [--mode shared|own|both] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
       return 2;
     }
   }
@@ -189,39 +201,45 @@ int main(int argc, char** argv) {
   }
   RoboticPlatform::setSimulationModeOn();  // real clock (the default), simulated arms
 
-  std::printf("simulated Puma 560 arms at 1 kHz on CPU %d, %.1f s per trial\n", cpu, seconds);
-  Trial best;
-  int bad = 0;
-  for (int n = start; n <= max; n *= 2) {
-    const Trial t = attempt(n, seconds, tries);
-    if (!good(t)) {
-      bad = n;
-      break;
+  std::vector<std::string> modes;
+  if (mode == "both" || mode == "shared") modes.push_back("shared");
+  if (mode == "both" || mode == "own") modes.push_back("own");
+  for (const std::string& m : modes) {
+    ControlProgram::setDefaultThreadMode(m == "own" ? ThreadMode::Own : ThreadMode::Shared);
+    std::printf("mode %s: simulated Puma 560 arms at 1 kHz on CPU %d, %.1f s per trial\n", m.c_str(), cpu, seconds);
+    Trial best;
+    int bad = 0;
+    for (int n = start; n <= max; n *= 2) {
+      const Trial t = attempt(n, seconds, tries);
+      if (!good(t)) {
+        bad = n;
+        break;
+      }
+      best = t;
     }
-    best = t;
-  }
-  if (bad == 0) {
-    std::printf("no overrun up to --max %d\n", max);
-  } else {
-    int lo = best.arms, hi = bad;  // lo good (0: none), hi bad
-    while (hi - lo > resolution) {
-      const int mid = lo + (hi - lo) / 2;
-      const Trial t = attempt(mid, seconds, tries);
-      if (good(t)) {
-        lo = mid;
-        best = t;
-      } else {
-        hi = mid;
+    if (bad == 0) {
+      std::printf("no overrun up to --max %d\n", max);
+    } else {
+      int lo = best.arms, hi = bad;  // lo good (0: none), hi bad
+      while (hi - lo > resolution) {
+        const int mid = lo + (hi - lo) / 2;
+        const Trial t = attempt(mid, seconds, tries);
+        if (good(t)) {
+          lo = mid;
+          best = t;
+        } else {
+          hi = mid;
+        }
       }
     }
+    if (best.arms == 0) {
+      std::printf("arms_per_core %s 0 (even %d arms missed deadlines)\n", m.c_str(), start);
+      continue;
+    }
+    std::printf("arms_per_core %s %d  cycle_p50_us %.1f  cycle_p99_us %.1f  wakeup_p99_us %.1f  wakeup_max_us %.1f  "
+                "cpu_us_per_arm_cycle %.2f  scheduling %s\n",
+                m.c_str(), best.arms, best.cycleP50, best.cycleP99, best.wakeupP99, best.wakeupMax, best.cpuPerCycle,
+                best.realTime ? "SCHED_FIFO" : "normal");
   }
-  if (best.arms == 0) {
-    std::printf("arms_per_core 0 (even %d arms missed deadlines)\n", start);
-    return 0;
-  }
-  std::printf("arms_per_core %d  cycle_p50_us %.1f  cycle_p99_us %.1f  wakeup_p99_us %.1f  wakeup_max_us %.1f  "
-              "cpu_us_per_arm_cycle %.2f  scheduling %s\n",
-              best.arms, best.cycleP50, best.cycleP99, best.wakeupP99, best.wakeupMax, best.cpuPerCycle,
-              best.realTime ? "SCHED_FIFO" : "normal");
   return 0;
 }

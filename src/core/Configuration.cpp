@@ -326,7 +326,7 @@ const SettingSpec* SettingSchema::find(const std::string& name) const {
 }
 
 std::string SettingSchema::knownNames() const {
-  std::vector<std::string> names{"qmotorConfig"};
+  std::vector<std::string> names{"cpu", "qmotorConfig", "thread"};
   for (const auto& s : specs_) names.push_back(s.name);
   std::sort(names.begin(), names.end());
   names.erase(std::unique(names.begin(), names.end()), names.end());
@@ -525,6 +525,24 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
       current->classLine_ = line.number;
       continue;
     }
+    if (name == "thread") {
+      // The control program's executor (docs/realtime.md, Executors): shared or its own thread.
+      if (setting.values.size() != 1 || (setting.values[0] != "own" && setting.values[0] != "shared"))
+        throw ConfigError(fileName, line.number,
+                          "setting 'thread' needs 1 value (own, shared), got " +
+                              (setting.values.size() == 1 ? "'" + ex(setting.values[0]) + "'"
+                                                          : std::to_string(setting.values.size()) + " values"));
+    }
+    if (name == "cpu") {
+      // The CPU the control program's thread is pinned to.
+      double v = 0;
+      if (setting.values.size() != 1 || !internal::parseNumber(setting.values[0], v) || v != std::floor(v) || v < 0 ||
+          v > 1023)
+        throw ConfigError(fileName, line.number,
+                          "setting 'cpu' needs 1 value, a CPU number in 0..1023, got " +
+                              (setting.values.size() == 1 ? "'" + ex(setting.values[0]) + "'"
+                                                          : std::to_string(setting.values.size()) + " values"));
+    }
     if (name == "qmotorConfig") {
       if (setting.values.size() != 1)
         throw ConfigError(fileName, line.number,
@@ -577,7 +595,7 @@ Configuration Configuration::parse(const std::string& text, const std::string& f
                               " objects without a section of their own, so its class must be " + section.name_ +
                               ", not " + ex(section.className_));
       for (const auto& s : section.settings_) {
-        if (s.name == "qmotorConfig") continue;
+        if (s.name == "qmotorConfig" || s.name == "thread" || s.name == "cpu") continue;
         const SettingSpec* spec = type->schema.find(s.name);
         if (!spec)
           throw ConfigError(fileName, s.line,

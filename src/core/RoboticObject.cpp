@@ -262,7 +262,22 @@ bool RoboticObject::handleMessage(const std::string&, const std::string&, std::s
 void RoboticObject::applyQMotorConfigFile() {
   if (impl_->qmotorApplied.exchange(true)) return;
   const ConfigSection* section = configSection();
-  if (section == nullptr || section->qmotorConfig() == nullptr) return;
+  if (section == nullptr) return;
+  // The executor settings (`thread own|shared`, `cpu N`): only for an object with a control program.
+  for (const char* name : {"thread", "cpu"}) {
+    const ConfigSetting* line = section->find(name);
+    if (line == nullptr) continue;
+    ControlProgram* p = getControlProgram();
+    if (p == nullptr)
+      throw section->errorAt(*line, std::string("setting '") + name + "': " + getName() + " (" + getClassName() +
+                                        ") runs no control program, so it has no thread to choose or pin");
+    if (std::string(name) == "thread") {
+      p->setThreadMode(line->values.at(0) == "own" ? ThreadMode::Own : ThreadMode::Shared);
+    } else {
+      p->setCpuAffinity(std::stoi(line->values.at(0)));
+    }
+  }
+  if (section->qmotorConfig() == nullptr) return;
   ControlProgram* p = getControlProgram();
   if (p == nullptr) {
     const ConfigSetting* line = section->find("qmotorConfig");

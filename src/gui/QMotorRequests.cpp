@@ -69,6 +69,19 @@ json statusOf(RoboticObject& object) {
   s["cycles"] = p->getCycleCount();
   s["rate"] = p->getRate();
   s["time"] = p->getTime();
+  // Timing (docs/realtime.md, Executors): the program's own computation time per cycle, and the
+  // wake-up latency and overruns of the executor that steps it.
+  const ControlStatistics t = p->getStatistics();
+  json timing = {{"computationP50", t.computationTime.p50}, {"computationP99", t.computationTime.p99},
+                 {"computationMax", t.computationTime.max}, {"wakeupP99", t.wakeupLatency.p99},
+                 {"overruns", t.overruns},                  {"ownThread", t.ownThread},
+                 {"executorPrograms", t.executorPrograms},  {"lastOverrunProgram", ""}};
+  for (const ExecutorStatistics& e : ControlProgram::getExecutorStatistics())
+    if (std::find(e.programs.begin(), e.programs.end(), p->getProgramName()) != e.programs.end()) {
+      timing["executorPrograms"] = e.programs.size();
+      timing["lastOverrunProgram"] = e.lastOverrunProgram;
+    }
+  s["timing"] = timing;
   json variables = json::array();
   for (const LogVariableInfo& v : p->getLogVariables())
     variables.push_back({{"name", v.name}, {"size", v.size}, {"vector", v.vector}, {"unit", v.unit}});

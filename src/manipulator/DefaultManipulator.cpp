@@ -758,7 +758,7 @@ void DefaultManipulator::exitControl() {
   shutdownPhase_.compare_exchange_strong(hold, 2);
 }
 
-void DefaultManipulator::control() {
+void DefaultManipulator::readInputs() {
   const double t = getTime();
   const double dt = getPeriod();
   const int n = model_->getNumberOfJoints();
@@ -795,11 +795,11 @@ void DefaultManipulator::control() {
   int phase = shutdownPhase_.load(std::memory_order_acquire);
   const bool wantPower =
       powerRequested_.load(std::memory_order_relaxed) && phase == 0 && !noHardware_.load(std::memory_order_relaxed);
-  bool poweredOn = false;  // in this cycle: a generator must then start where the arm is (below)
+  poweredOn_ = false;  // in this cycle: a generator must then start where the arm is (control())
   if (wantPower != power_ && phase == 0) {
     power_ = wantPower;
     sim_->setBrakes(!power_);
-    poweredOn = power_;
+    poweredOn_ = power_;
     if (power_) activeControl_ = nullptr;  // a hand-over: activate() again below, holding where the arm is
   }
   if (board_) {
@@ -819,12 +819,21 @@ void DefaultManipulator::control() {
   missedCycles_ = static_cast<double>(getMissedCycleCount());
   // A joint reading that is not a number cannot be controlled: power off at once (no damped
   // hold can be computed from it).
+  readFailed_ = false;
   if (const int bad = std::max(firstNonFinite(q_), firstNonFinite(qd_)); bad >= 0) {
     std::snprintf(errorBuffer_, sizeof errorBuffer_, "%.60s: joint %d reading is not a number (position %g, velocity %g)",
                   nameBuffer_, bad + 1, q_(bad), qd_(bad));
     powerOffNow();
-    return finishCycle(t, dt);
+    readFailed_ = true;
   }
+}
+
+void DefaultManipulator::control() {
+  if (readFailed_) return;  // powered off in the read phase; the write phase writes the outputs off
+  const double t = getTime();
+  const double dt = getPeriod();
+  const bool poweredOn = poweredOn_;
+  int phase = shutdownPhase_.load(std::memory_order_acquire);
 
   // 2. The setpoint: the trajectory generator's, or hold. Every hand-over holds the arm where it
   // is in this cycle (the joints just read), never at a stale pose: the servo control in use
@@ -926,8 +935,9 @@ void DefaultManipulator::control() {
       shutdownPhase_.store(2, std::memory_order_release);
     }
   }
-  finishCycle(t, dt);
 }
+
+void DefaultManipulator::writeOutputs() { finishCycle(getTime(), getPeriod()); }
 
 void DefaultManipulator::finishCycle(double t, double dt) {
   // 5. Output: no torque without power; the simulation integrates the dynamics over one period.

@@ -62,7 +62,9 @@ bool SimulatedClock::isPaused() const {
 
 int SimulatedClock::getNumberOfPrograms() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return static_cast<int>(participants_.size());
+  int n = 0;
+  for (const Participant* p : participants_) n += p->programs.load();
+  return n;
 }
 
 void SimulatedClock::attach(Participant& p) {

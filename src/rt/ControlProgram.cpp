@@ -106,6 +106,52 @@ thread_local const void* currentLoop = nullptr;  // the program whose loop runs 
 std::once_flag memoryLocked, cpuLatencySet;
 
 }  // namespace
+
+// What cyclictest does for its measuring thread, each when allowed, each refusal said once per
+// process: lock all memory (MCL_FUTURE: the heap and stacks to come as well), keep the CPUs out
+// of deep idle states (0 us in /dev/cpu_dma_latency, held while the process lives), SCHED_FIFO at
+// the priority, the CPU affinity if one was set; and always: a timer slack of 1 ns (a thread with
+// normal scheduling would otherwise wake up to 50 us late) and a touched stack.
+bool setUpRealTime(int priority, int cpu) {
+#ifndef RP_UNDER_SANITIZER
+  std::call_once(internal::memoryLocked, [] {
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+      std::fprintf(stderr, "rp: mlockall failed (%s): memory may be paged out\n", std::strerror(errno));
+  });
+#endif
+  std::call_once(internal::cpuLatencySet, [] {
+    // The PM QoS request lasts as long as the file stays open: never closed.
+    const int fd = open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+    const std::int32_t zero = 0;
+    if (fd < 0 || write(fd, &zero, sizeof zero) != static_cast<ssize_t>(sizeof zero)) {
+      std::fprintf(stderr, "rp: cannot set /dev/cpu_dma_latency to 0 (%s): CPUs may wake slowly from idle\n",
+                   std::strerror(errno));
+      if (fd >= 0) close(fd);
+    }
+  });
+  prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  if (cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(static_cast<unsigned>(cpu), &set);
+    const int err = cpu < CPU_SETSIZE ? pthread_setaffinity_np(pthread_self(), sizeof set, &set) : EINVAL;
+    if (err != 0 && !internal::affinityWarned.exchange(true))
+      std::fprintf(stderr, "rp: cannot pin the control loop to CPU %d (%s): it runs unpinned\n", cpu,
+                   std::strerror(err));
+  }
+  sched_param sp{};
+  sp.sched_priority = priority;
+  const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+  if (err != 0 && !internal::schedulingWarned.exchange(true))
+    std::fprintf(stderr,
+                 "rp: cannot use SCHED_FIFO priority %d (%s): control loops run with normal scheduling\n",
+                 priority, std::strerror(err));
+  // Touch the stack the loop will use so the first cycles do not page-fault.
+  volatile char stack[64 * 1024];
+  for (std::size_t i = 0; i < sizeof stack; i += 4096) stack[i] = 0;
+  return err == 0;
+}
+
 }  // namespace internal
 
 // The name of value `i` of log variable `v`: `program.name` or `program.name[i]` (the log's
@@ -136,7 +182,6 @@ struct ControlProgram::Impl {
 
   // Lifecycle.
   std::mutex lifecycle;
-  std::thread thread;
   std::atomic<bool> running{false};
   std::atomic<bool> stopRequested{false};
   std::mutex endMutex;
@@ -151,7 +196,6 @@ struct ControlProgram::Impl {
   std::atomic<std::uint64_t> logSamples{0};
   std::atomic<bool> realTime{false};
   internal::DurationStats latency, computation;
-  SimulatedClock::Participant participant;
 
   // Log variables.
   struct LogVar {
@@ -289,11 +333,9 @@ struct ControlProgram::Impl {
     p.dirty.store(true, std::memory_order_release);
   }
 
-  // Real-time: one cycle at clock time t.
-  void cycle(double t, std::uint64_t k) noexcept {
-    time.store(t, std::memory_order_relaxed);
-    applyParameters();
-    self.control();
+  // Real-time: the bookkeeping after a program's phases (QMotor's log, the log file's sample,
+  // the cycle count), at clock time t in its cycle k.
+  void finishCycle(double t, std::uint64_t k) noexcept {
     sampleCapture(t);
     if (channel && k % logEvery == 0) {
       if (double* slot = channel->beginPush()) {
@@ -304,84 +346,6 @@ struct ControlProgram::Impl {
       logSamples.fetch_add(1, std::memory_order_relaxed);
     }
     cycles.fetch_add(1, std::memory_order_relaxed);
-  }
-
-  // What cyclictest does for its measuring thread, each when allowed, each refusal said once per
-  // process: lock all memory (MCL_FUTURE: the heap and stacks to come as well), keep the CPUs out
-  // of deep idle states (0 us in /dev/cpu_dma_latency, held while the process lives), SCHED_FIFO at
-  // the priority, the CPU affinity if one was set; and always: a timer slack of 1 ns (a thread with
-  // normal scheduling would otherwise wake up to 50 us late) and a touched stack.
-  void setUpRealTime() {
-#ifndef RP_UNDER_SANITIZER
-    std::call_once(internal::memoryLocked, [] {
-      if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-        std::fprintf(stderr, "rp: mlockall failed (%s): memory may be paged out\n", std::strerror(errno));
-    });
-#endif
-    std::call_once(internal::cpuLatencySet, [] {
-      // The PM QoS request lasts as long as the file stays open: never closed.
-      const int fd = open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
-      const std::int32_t zero = 0;
-      if (fd < 0 || write(fd, &zero, sizeof zero) != static_cast<ssize_t>(sizeof zero)) {
-        std::fprintf(stderr, "rp: cannot set /dev/cpu_dma_latency to 0 (%s): CPUs may wake slowly from idle\n",
-                     std::strerror(errno));
-        if (fd >= 0) close(fd);
-      }
-    });
-    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
-    if (cpu >= 0) {
-      cpu_set_t set;
-      CPU_ZERO(&set);
-      CPU_SET(static_cast<unsigned>(cpu), &set);
-      const int err = cpu < CPU_SETSIZE ? pthread_setaffinity_np(pthread_self(), sizeof set, &set) : EINVAL;
-      if (err != 0 && !internal::affinityWarned.exchange(true))
-        std::fprintf(stderr, "rp: cannot pin the control loop to CPU %d (%s): it runs unpinned\n", cpu,
-                     std::strerror(err));
-    }
-    sched_param sp{};
-    sp.sched_priority = priority;
-    const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
-    realTime = err == 0;
-    if (err != 0 && !internal::schedulingWarned.exchange(true))
-      std::fprintf(stderr,
-                   "rp: cannot use SCHED_FIFO priority %d (%s): control loops run with normal scheduling\n",
-                   priority, std::strerror(err));
-    // Touch the stack the loop will use so the first cycles do not page-fault.
-    volatile char stack[64 * 1024];
-    for (std::size_t i = 0; i < sizeof stack; i += 4096) stack[i] = 0;
-  }
-
-  void runReal() {
-    setUpRealTime();
-    const auto period = static_cast<std::int64_t>(std::llround(1e9 / rate));
-    const std::int64_t epoch = RealClock::instance().epochNanoseconds();
-    // The first deadline is one period away (as in cyclictest), so every wake-up is a real one.
-    std::int64_t deadline = internal::monotonicNanoseconds() + period;
-    std::uint64_t k = 0;
-    while (!stopRequested.load(std::memory_order_relaxed)) {
-      // Sleep until the absolute deadline, in slices so that stop() is never kept waiting long.
-      // The clock is read first thing after each wake-up: that reading is the one timed.
-      std::int64_t woke = internal::monotonicNanoseconds();
-      while (woke < deadline && !stopRequested.load(std::memory_order_relaxed)) {
-        const std::int64_t until = std::min<std::int64_t>(deadline, woke + 100000000LL);
-        timespec ts{static_cast<time_t>(until / 1000000000LL), static_cast<long>(until % 1000000000LL)};
-        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
-        woke = internal::monotonicNanoseconds();
-      }
-      if (stopRequested.load(std::memory_order_relaxed)) break;
-      latency.add(woke - deadline);
-      cycle(static_cast<double>(deadline - epoch) * 1e-9, k++);
-      const std::int64_t done = internal::monotonicNanoseconds();
-      computation.add(done - woke);
-      deadline += period;
-      if (done > deadline) {  // overrun: skip the deadlines already missed
-        overruns.fetch_add(1, std::memory_order_relaxed);
-        const std::int64_t skipped = (done - deadline) / period + 1;
-        missed.fetch_add(static_cast<std::uint64_t>(skipped), std::memory_order_relaxed);
-        deadline += skipped * period;
-      }
-      if (cycleLimit && k >= cycleLimit) break;
-    }
   }
 
   // On the simulated clock time waits for every program, so a program may also wait for the log
@@ -410,48 +374,362 @@ struct ControlProgram::Impl {
     return std::max(now, (nextTick + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle);
   }
 
-  void runSimulated(SimulatedClock& sim) {
-    const auto ticksPerCycle =
-        static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / rate / sim.getStep())));
-    std::uint64_t tick = firstSimulatedTick(sim, ticksPerCycle);
-    std::uint64_t k = 0;
-    while (sim.waitForTick(participant, tick, stopRequested)) {
+  // Executor: which thread steps the program, and its state in that thread.
+  ThreadMode threadMode = ThreadMode::Shared;
+  std::atomic<Executor*> executor{nullptr};  // set by start(), cleared by stop() (lifecycle mutex)
+  std::atomic<bool> loopEnded{false};         // exitControl() ran (the executor no longer steps it)
+  std::size_t executorPrograms = 0;           // programs of the executor when it was last started
+  // Loop thread only:
+  bool entered = false;          // enterControl() ran
+  bool joining = false;          // entered in the current cycle
+  std::uint64_t startTick = 0;   // simulated clock: the first tick it may run
+  std::uint64_t k = 0;           // cycles run in this run
+  std::int64_t cycleNs = 0;      // computation time in the current cycle
+
+  // Loop thread: before the first cycle.
+  void enter() {
+    entered = true;
+    internal::currentLoop = this;
+    self.enterControl();
+  }
+
+  // Loop thread: after the last cycle (cycle limit or stop request).
+  void finish();
+};
+
+namespace internal {
+namespace {
+std::atomic<int>& defaultThreadMode() {
+  static std::atomic<int> mode{[] {
+    const char* e = std::getenv("RP_CONTROL_THREADS");
+    return e != nullptr && std::string(e) == "own" ? static_cast<int>(ThreadMode::Own) : static_cast<int>(ThreadMode::Shared);
+  }()};
+  return mode;
+}
+thread_local const void* currentExecutor = nullptr;  // the executor whose loop runs in this thread
+}  // namespace
+}  // namespace internal
+
+// One periodic thread stepping the programs of one clock, rate, priority and CPU (or one program
+// with a thread of its own) in three phases: every program's readInputs(), then every control(),
+// then every writeOutputs(), each in the order the programs were started.
+//
+// The list of programs is a vector built outside the loop (start(), stop(), under the registry's
+// mutex) and published through an atomic pointer; the loop announces the list it holds during a
+// cycle in a hazard pointer (`inUse`), and replaced lists are freed only once the loop does not
+// hold them. start() never waits for the loop (a program's cycle may wait for a lock its caller
+// holds); stop() waits until the loop holds no list with the program in it. So adding or removing
+// a program never allocates, locks or waits in the loop.
+struct ControlProgram::Executor {
+  using Impl = ControlProgram::Impl;
+  using List = std::vector<Impl*>;
+
+  // Settings (fixed while the executor is in the registry).
+  Clock* clock = nullptr;
+  std::atomic<SimulatedClock*> sim{nullptr};  // while the thread runs on a simulated clock
+  double rate = 1000;
+  int priority = 27;
+  int cpu = -1;
+  bool own = false;
+  std::uint64_t ticksPerCycle = 1;
+  std::uint64_t firstTick = 0;
+
+  // Lifecycle (registry mutex), and the flags the loop reads.
+  std::thread thread;
+  bool exited = false;                  // the loop has ended or is ending: no program may join
+  std::atomic<bool> quit{false};        // end the loop (its list is empty)
+  std::atomic<bool> attention{false};   // a program asked to stop
+  std::unique_ptr<List> owned;          // the list the loop sees
+  std::vector<std::unique_ptr<List>> retired;  // lists replaced from the loop's own thread
+  std::atomic<List*> list{nullptr};
+  std::atomic<List*> inUse{nullptr};
+  SimulatedClock::Participant participant;
+
+  // Statistics.
+  std::atomic<std::uint64_t> cycles{0}, overruns{0}, missed{0};
+  internal::DurationStats latency, cycleTime;
+  std::atomic<bool> realTime{false};
+  std::atomic<const Impl*> overrunProgram{nullptr};
+  std::atomic<std::int64_t> overrunNs{0};
+  std::string overrunName;  // registry mutex: the name of overrunProgram once it is removed
+
+  static std::mutex& registryMutex() {
+    static auto* m = new std::mutex;
+    return *m;
+  }
+  // Executors in the order they were created; ended ones are kept for reuse (a late
+  // requestStop() may still touch one, so they are never freed).
+  static std::vector<Executor*>& registry() {
+    static auto* v = new std::vector<Executor*>;
+    return *v;
+  }
+  static std::vector<Executor*>& pool() {
+    static auto* v = new std::vector<Executor*>;
+    return *v;
+  }
+
+  // Wakes the loop to look at stop requests. Real-time safe: yes (the simulated clock's
+  // interrupt() takes its mutex; only the simulated clock needs the wake-up).
+  void wake() noexcept {
+    attention.store(true);
+    if (SimulatedClock* s = sim.load()) s->interrupt();
+  }
+
+  // Registry mutex held: publishes `next` to the loop; with `wait` (and not from the loop's own
+  // thread), returns once the loop holds no earlier list; frees the replaced lists the loop does
+  // not hold.
+  void replaceList(std::unique_ptr<List> next, bool wait) {
+    List* raw = next.get();
+    int live = 0;
+    if (raw != nullptr)
+      for (const Impl* p : *raw) live += !p->loopEnded.load();
+    participant.programs.store(live);
+    list.exchange(raw);  // sequentially consistent with the loop's acquire()
+    if (owned) retired.push_back(std::move(owned));
+    owned = std::move(next);
+    if (wait && internal::currentExecutor != this)
+      for (List* held = inUse.load(); held != nullptr && held != raw; held = inUse.load()) std::this_thread::yield();
+    // The loop can only take the current list from now on: every other one it does not hold now
+    // is free.
+    List* const held = inUse.load();
+    retired.erase(std::remove_if(retired.begin(), retired.end(), [&](const auto& l) { return l.get() != held; }),
+                  retired.end());
+  }
+
+  // Loop: takes the current list (announced in `inUse`, then checked to be still current).
+  List* acquire() noexcept {
+    List* l = list.load();
+    for (;;) {
+      inUse.store(l);
+      List* now = list.load();
+      if (now == l) return l;
+      l = now;
+    }
+  }
+  void release() noexcept { inUse.store(nullptr); }
+
+  // Loop: stops the programs that asked to, between cycles.
+  void handleStopRequests() {
+    if (List* l = acquire())
+      for (Impl* p : *l)
+        if (!p->loopEnded.load(std::memory_order_relaxed) && p->stopRequested.load(std::memory_order_relaxed))
+          p->finish();
+    release();
+  }
+
+  // Loop: true if no program is left to step; then the executor is marked ended (no program
+  // joins it any more) and the loop must end.
+  bool endIfIdle() {
+    std::lock_guard<std::mutex> lock(registryMutex());
+    if (const List* l = owned.get())
+      for (const Impl* p : *l)
+        if (!p->loopEnded.load()) return false;
+    exited = true;
+    return true;
+  }
+
+  // Loop: one cycle at clock time t (tick: the simulated clock's, woke: when the thread woke
+  // [ns], latencyNs: how late, or -1 on the simulated clock). Returns the number of programs
+  // still to step and sets `done` to the time the phases ended [ns].
+  //
+  // catchUp (simulated clock): a cycle of only the programs that joined after the executor had
+  // run their first tick `tick` (a program started at tick 0 on a paused clock just after the
+  // first one): they run that tick as they would have in a thread of their own.
+  std::size_t step(double t, std::uint64_t tick, std::int64_t woke, std::int64_t latencyNs, std::int64_t deadline,
+                   std::int64_t period, bool catchUp = false) noexcept {
+    const bool simulated = latencyNs < 0;
+    std::size_t live = 0;
+    List* l = acquire();
+    if (l != nullptr) {
+      // Programs that start or stop: between cycles (enterControl() and exitControl() are not
+      // time-critical).
+      for (Impl* p : *l) {
+        if (p->loopEnded.load(std::memory_order_relaxed)) continue;
+        if (p->stopRequested.load(std::memory_order_relaxed)) {
+          p->finish();
+          continue;
+        }
+        ++live;
+        p->joining = false;
+        if (!p->entered && (!simulated || tick >= p->startTick)) {
+          p->realTime.store(realTime.load(std::memory_order_relaxed));
+          p->enter();
+          p->joining = true;
+        }
+      }
+      auto active = [&](const Impl* p) {
+        return p->entered && !p->loopEnded.load(std::memory_order_relaxed) && (!simulated || tick >= p->startTick) &&
+               (!catchUp || p->joining);
+      };
+      std::int64_t last = woke;
+      auto charge = [&](Impl* p) {
+        const std::int64_t now = internal::monotonicNanoseconds();
+        p->cycleNs += now - last;
+        last = now;
+      };
+      // Phase 1: parameters and inputs.
+      for (Impl* p : *l) {
+        if (!active(p)) continue;
+        internal::currentLoop = p;
+        p->cycleNs = 0;
+        p->time.store(t, std::memory_order_relaxed);
+        p->applyParameters();
+        p->self.readInputs();
+        charge(p);
+      }
+      // Phase 2: control laws, each seeing every program's inputs of this cycle.
+      for (Impl* p : *l) {
+        if (!active(p)) continue;
+        internal::currentLoop = p;
+        p->self.control();
+        charge(p);
+      }
+      // Phase 3: outputs.
+      for (Impl* p : *l) {
+        if (!active(p)) continue;
+        internal::currentLoop = p;
+        p->self.writeOutputs();
+        charge(p);
+      }
+      // Bookkeeping: logs, statistics, cycle limits.
+      const std::int64_t done = last;
+      const bool overrun = !simulated && done > deadline + period;
+      const Impl* slowest = nullptr;
+      std::int64_t skipped = 0;
+      if (overrun) skipped = (done - deadline - period) / period + 1;
+      for (Impl* p : *l) {
+        if (!active(p)) continue;
+        internal::currentLoop = p;
+        p->finishCycle(t, p->k++);
+        p->computation.add(p->cycleNs);
+        if (!simulated) p->latency.add(latencyNs);
+        if (overrun) {
+          p->overruns.fetch_add(1, std::memory_order_relaxed);
+          p->missed.fetch_add(static_cast<std::uint64_t>(skipped), std::memory_order_relaxed);
+          if (slowest == nullptr || p->cycleNs > slowest->cycleNs) slowest = p;
+        }
+        if (simulated) {
+          p->nextTick = tick + ticksPerCycle;
+          p->waitForLogRoom();
+        }
+        if (p->cycleLimit && p->k >= p->cycleLimit) {
+          p->finish();
+          --live;
+        }
+      }
+      if (slowest != nullptr) {
+        overrunProgram.store(slowest, std::memory_order_relaxed);
+        overrunNs.store(slowest->cycleNs, std::memory_order_relaxed);
+      }
+      internal::currentLoop = nullptr;
+    }
+    release();
+    return live;
+  }
+
+  void runReal() {
+    realTime = internal::setUpRealTime(priority, cpu);
+    const auto period = static_cast<std::int64_t>(std::llround(1e9 / rate));
+    const std::int64_t epoch = RealClock::instance().epochNanoseconds();
+    // The first deadline is one period away (as in cyclictest), so every wake-up is a real one.
+    std::int64_t deadline = internal::monotonicNanoseconds() + period;
+    while (!quit.load(std::memory_order_relaxed)) {
+      // Sleep until the absolute deadline, in slices so that a stop is never kept waiting long.
+      // The clock is read first thing after each wake-up: that reading is the one timed.
+      std::int64_t woke = internal::monotonicNanoseconds();
+      while (woke < deadline && !quit.load(std::memory_order_relaxed)) {
+        if (attention.load(std::memory_order_relaxed)) {
+          attention.store(false);
+          handleStopRequests();
+          if (endIfIdle()) return;
+        }
+        const std::int64_t until = std::min<std::int64_t>(deadline, woke + 10000000LL);
+        timespec ts{static_cast<time_t>(until / 1000000000LL), static_cast<long>(until % 1000000000LL)};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+        woke = internal::monotonicNanoseconds();
+      }
+      if (quit.load(std::memory_order_relaxed)) break;
+      latency.add(woke - deadline);
+      const std::size_t live = step(static_cast<double>(deadline - epoch) * 1e-9, 0, woke, woke - deadline, deadline, period);
+      const std::int64_t done = internal::monotonicNanoseconds();
+      cycleTime.add(done - woke);
+      cycles.fetch_add(1, std::memory_order_relaxed);
+      deadline += period;
+      if (done > deadline) {  // overrun: skip the deadlines already missed
+        overruns.fetch_add(1, std::memory_order_relaxed);
+        const std::int64_t skipped = (done - deadline) / period + 1;
+        missed.fetch_add(static_cast<std::uint64_t>(skipped), std::memory_order_relaxed);
+        deadline += skipped * period;
+      }
+      if (live == 0 && endIfIdle()) return;
+    }
+  }
+
+  void runSimulated(SimulatedClock& clk) {
+    std::uint64_t tick = firstTick;
+    bool ran = false;  // a tick has run (tick - ticksPerCycle)
+    while (!quit.load()) {
+      if (!clk.waitForTick(participant, tick, attention)) {
+        attention.store(false);
+        if (quit.load()) break;
+        handleStopRequests();
+        if (ran) {
+          // Programs that joined too late for the tick just run: they run it on their own.
+          const std::uint64_t last = tick - ticksPerCycle;
+          step(clk.tickTime(last), last, internal::monotonicNanoseconds(), -1, 0, 0, true);
+        }
+        if (endIfIdle()) break;
+        continue;
+      }
       const std::int64_t start = internal::monotonicNanoseconds();
-      cycle(sim.tickTime(tick), k++);
-      computation.add(internal::monotonicNanoseconds() - start);
-      waitForLogRoom();
+      const std::size_t live = step(clk.tickTime(tick), tick, start, -1, 0, 0);
+      cycleTime.add(internal::monotonicNanoseconds() - start);
+      cycles.fetch_add(1, std::memory_order_relaxed);
+      ran = true;
       tick += ticksPerCycle;
-      nextTick = tick;
-      if (cycleLimit && k >= cycleLimit) break;
+      if (live == 0 && endIfIdle()) break;
     }
   }
 
   void threadMain() {
-    internal::currentLoop = this;
-    self.enterControl();
-    if (auto* sim = dynamic_cast<SimulatedClock*>(clock)) {
-      runSimulated(*sim);
-      sim->detach(participant);
+    internal::currentExecutor = this;
+    if (SimulatedClock* s = sim.load()) {
+      runSimulated(*s);
+      sim.store(nullptr);
+      s->detach(participant);
     } else {
       runReal();
     }
-    self.exitControl();
-    // Missed cycles are reported when the loop ends (the cycle statistics and the log have them
-    // too), so that rows missing from a log never go unexplained.
-    if (const std::uint64_t m = missed.load())
-      std::fprintf(stderr, "rp: %s: %llu servo cycles missed in %llu overruns (of %llu cycles run)\n", name.c_str(),
-                   static_cast<unsigned long long>(m), static_cast<unsigned long long>(overruns.load()),
-                   static_cast<unsigned long long>(cycles.load()));
-    {
-      std::lock_guard<std::mutex> lock(endMutex);
-      ended = true;
-    }
-    endCv.notify_all();
+    // Programs whose stop request came with the end (stop() waits for them).
+    handleStopRequests();
+    internal::currentExecutor = nullptr;
   }
 };
 
+// Loop thread: after the last cycle (cycle limit or stop request).
+void ControlProgram::Impl::finish() {
+  if (!entered) enter();
+  internal::currentLoop = this;
+  self.exitControl();
+  internal::currentLoop = nullptr;
+  // Missed cycles are reported when the loop ends (the cycle statistics and the log have them
+  // too), so that rows missing from a log never go unexplained.
+  if (const std::uint64_t m = missed.load())
+    std::fprintf(stderr, "rp: %s: %llu servo cycles missed in %llu overruns (of %llu cycles run)\n", name.c_str(),
+                 static_cast<unsigned long long>(m), static_cast<unsigned long long>(overruns.load()),
+                 static_cast<unsigned long long>(cycles.load()));
+  loopEnded.store(true, std::memory_order_release);
+  if (Executor* e = executor.load()) e->participant.programs.fetch_sub(1);
+  {
+    std::lock_guard<std::mutex> lock(endMutex);
+    ended = true;
+  }
+  endCv.notify_all();
+}
+
 ControlProgram::ControlProgram(const std::string& programName) : impl_(std::make_unique<Impl>(*this)) {
   impl_->name = programName;
+  impl_->threadMode = getDefaultThreadMode();
   std::lock_guard<std::mutex> lock(internal::programsMutex());
   internal::programs().push_back(this);
 }
@@ -507,10 +785,19 @@ void ControlProgram::setCycleLimit(std::uint64_t cycles) {
   impl_->cycleLimit = cycles;
 }
 
+void ControlProgram::setThreadMode(ThreadMode mode) {
+  impl_->checkNotRunning("setThreadMode");
+  impl_->threadMode = mode;
+}
+ThreadMode ControlProgram::getThreadMode() const { return impl_->threadMode; }
+void ControlProgram::setDefaultThreadMode(ThreadMode mode) { internal::defaultThreadMode().store(static_cast<int>(mode)); }
+ThreadMode ControlProgram::getDefaultThreadMode() { return static_cast<ThreadMode>(internal::defaultThreadMode().load()); }
+
 void ControlProgram::start() {
   std::lock_guard<std::mutex> lock(impl_->lifecycle);
   Impl& d = *impl_;
-  if (d.running.load() || d.thread.joinable()) throw std::logic_error("ControlProgram::start: " + d.name + " is already running");
+  if (d.running.load() || d.executor.load() != nullptr)
+    throw std::logic_error("ControlProgram::start: " + d.name + " is already running");
   internal::ensureShutdownWatcher();
   if (!d.clock) d.clock = &RoboticPlatform::getDefaultClock();
   d.stopRequested = false;
@@ -556,13 +843,20 @@ void ControlProgram::start() {
     std::lock_guard<std::mutex> elock(d.endMutex);
     d.ended = false;
   }
-  // Once attached, the simulated clock cannot pass this program's first tick, so the time of the
-  // first sample is known now: the writer holds back rows from that time on until it arrives.
+  d.entered = false;
+  d.loopEnded = false;
+  d.k = 0;
+  // The first cycle: on the simulated clock the next multiple of the period (the executor the
+  // program joins runs on such ticks, and the clock cannot pass an executor's next tick before it
+  // has run), so the time of the first sample is known now: the writer holds back rows from that
+  // time on until it arrives.
+  auto* sim = dynamic_cast<SimulatedClock*>(d.clock);
+  std::uint64_t ticksPerCycle = 1;
   double firstTime;
-  if (auto* sim = dynamic_cast<SimulatedClock*>(d.clock)) {
-    sim->attach(d.participant);
-    const auto m = static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / d.rate / sim->getStep())));
-    firstTime = sim->tickTime(d.firstSimulatedTick(*sim, m));
+  if (sim != nullptr) {
+    ticksPerCycle = static_cast<std::uint64_t>(std::max<long long>(1, std::llround(1.0 / d.rate / sim->getStep())));
+    d.startTick = d.firstSimulatedTick(*sim, ticksPerCycle);
+    firstTime = sim->tickTime(d.startTick);
   } else {
     firstTime = RealClock::instance().getTime();
   }
@@ -576,27 +870,114 @@ void ControlProgram::start() {
     writer->addChannel(d.channel);
   }
   d.running = true;
-  d.thread = std::thread([&d] { d.threadMain(); });
+
+  // The executor: the running one of this clock, rate, priority and CPU, or a new one.
+  const bool own = d.threadMode == ThreadMode::Own;
+  std::lock_guard<std::mutex> rlock(Executor::registryMutex());
+  Executor* e = nullptr;
+  if (!own)
+    for (Executor* x : Executor::registry())
+      if (!x->own && !x->exited && x->clock == d.clock && x->rate == d.rate && x->priority == d.priority && x->cpu == d.cpu) {
+        e = x;
+        break;
+      }
+  const bool fresh = e == nullptr;
+  if (fresh) {
+    if (!Executor::pool().empty()) {
+      e = Executor::pool().back();
+      Executor::pool().pop_back();
+    } else {
+      e = new Executor;  // never freed (see registry())
+    }
+    e->clock = d.clock;
+    e->rate = d.rate;
+    e->priority = d.priority;
+    e->cpu = d.cpu;
+    e->own = own;
+    e->ticksPerCycle = ticksPerCycle;
+    e->firstTick = d.startTick;
+    e->exited = false;
+    e->quit = false;
+    e->attention = false;
+    e->cycles = 0;
+    e->overruns = 0;
+    e->missed = 0;
+    e->latency.reset();
+    e->cycleTime.reset();
+    e->realTime = false;
+    e->overrunProgram = nullptr;
+    e->overrunNs = 0;
+    e->overrunName.clear();
+    e->retired.clear();
+    Executor::registry().push_back(e);
+  }
+  auto next = std::make_unique<Executor::List>();
+  if (e->owned) *next = *e->owned;
+  next->push_back(&d);
+  d.executorPrograms = next->size();
+  e->replaceList(std::move(next), false);
+  d.executor.store(e);
+  // On the simulated clock a program whose first tick the executor has already run runs it in a
+  // catch-up cycle: wake the executor to look.
+  if (!fresh && sim != nullptr) e->wake();
+  if (fresh) {
+    if (sim != nullptr) {
+      // Attached now: the clock cannot pass the first tick before the loop has run it.
+      e->sim.store(sim);
+      sim->attach(e->participant);
+    } else {
+      e->sim.store(nullptr);
+    }
+    e->thread = std::thread([e] { e->threadMain(); });
+  }
 }
 
 void ControlProgram::requestStop() noexcept {
   impl_->stopRequested.store(true);
-  if (auto* sim = dynamic_cast<SimulatedClock*>(impl_->clock)) {
-    // interrupt() takes the clock's mutex; only the simulated clock needs the wake-up.
-    sim->interrupt();
-  }
+  if (Executor* e = impl_->executor.load()) e->wake();
 }
 
 void ControlProgram::stop() {
   Impl& d = *impl_;
-  if (internal::currentLoop == &d) {  // called from the loop itself: only ask
+  Executor* const e = d.executor.load();
+  if (e != nullptr && internal::currentExecutor == e) {  // called from the loop itself: only ask
     requestStop();
     return;
   }
   std::lock_guard<std::mutex> lock(d.lifecycle);
-  if (!d.thread.joinable()) return;
+  if (d.executor.load() == nullptr) return;
   requestStop();
-  d.thread.join();
+  {
+    std::unique_lock<std::mutex> elock(d.endMutex);
+    d.endCv.wait(elock, [&] { return d.ended; });
+  }
+  std::thread finished;
+  {
+    std::lock_guard<std::mutex> rlock(Executor::registryMutex());
+    auto next = std::make_unique<Executor::List>();
+    for (Impl* p : *e->owned)
+      if (p != &d) next->push_back(p);
+    if (e->overrunProgram.load() == &d) {
+      e->overrunName = d.name;
+      e->overrunProgram.store(nullptr);
+    }
+    const bool empty = next->empty();
+    e->replaceList(empty ? nullptr : std::move(next), true);
+    d.executor.store(nullptr);
+    if (empty) {
+      e->exited = true;
+      e->quit = true;
+      e->wake();
+      finished = std::move(e->thread);
+    }
+  }
+  if (finished.joinable()) {
+    finished.join();
+    std::lock_guard<std::mutex> rlock(Executor::registryMutex());
+    auto& r = Executor::registry();
+    r.erase(std::remove(r.begin(), r.end(), e), r.end());
+    Executor::pool().push_back(e);
+  }
   d.running = false;
   if (d.channel) {
     d.channel->finished.store(true);
@@ -612,7 +993,9 @@ void ControlProgram::waitUntilStopped() {
   stop();
 }
 
-bool ControlProgram::isLoopThread() noexcept { return internal::currentLoop != nullptr; }
+bool ControlProgram::isLoopThread() noexcept {
+  return internal::currentLoop != nullptr || internal::currentExecutor != nullptr;
+}
 
 bool ControlProgram::isRunning() const noexcept { return impl_->running.load(); }
 double ControlProgram::getTime() const noexcept { return impl_->time.load(std::memory_order_relaxed); }
@@ -632,7 +1015,35 @@ ControlStatistics ControlProgram::getStatistics() const {
   s.lostLogSamples = impl_->channel ? impl_->channel->lost.load() : 0;
   s.realTimeScheduling = impl_->realTime.load();
   s.simulatedClock = impl_->clock && impl_->clock->isSimulated();
+  s.ownThread = impl_->threadMode == ThreadMode::Own;
+  s.executorPrograms = impl_->executorPrograms;
   return s;
+}
+
+std::vector<ExecutorStatistics> ControlProgram::getExecutorStatistics() {
+  std::vector<ExecutorStatistics> out;
+  std::lock_guard<std::mutex> lock(Executor::registryMutex());
+  for (const Executor* e : Executor::registry()) {
+    ExecutorStatistics s;
+    s.rate = e->rate;
+    s.priority = e->priority;
+    s.cpu = e->cpu;
+    s.ownThread = e->own;
+    s.simulatedClock = e->clock != nullptr && e->clock->isSimulated();
+    s.realTimeScheduling = e->realTime.load();
+    if (e->owned)
+      for (const Impl* p : *e->owned) s.programs.push_back(p->name);
+    s.cycles = e->cycles.load();
+    s.overruns = e->overruns.load();
+    s.missedCycles = e->missed.load();
+    s.wakeupLatency = e->latency.summary();
+    s.cycleTime = e->cycleTime.summary();
+    const Impl* slowest = e->overrunProgram.load();
+    s.lastOverrunProgram = slowest != nullptr ? slowest->name : e->overrunName;
+    s.lastOverrunProgramTime = static_cast<double>(e->overrunNs.load()) / 1000.0;
+    out.push_back(std::move(s));
+  }
+  return out;
 }
 
 void ControlProgram::registerLogVariable(const std::string& name, const double& variable, const std::string& unit) {

@@ -101,7 +101,7 @@ struct Malformed {
 
 std::string known() { return TypeDatabase::instance().knownNames(); }
 const std::string kArmSettings =
-    "count, display, gain, mode, orientation, port, position, qmotorConfig, simulationMode";
+    "count, cpu, display, gain, mode, orientation, port, position, qmotorConfig, simulationMode, thread";
 
 class MalformedFile : public ::testing::TestWithParam<Malformed> {};
 
@@ -171,7 +171,11 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"[a]\nclass TestArm\ngain 1\n", "rp.cfg:3: setting 'gain' needs 2 values (kp kd [N/m]), got 1"},
         Malformed{"[a]\nclass TestArm\n3d on\n", "rp.cfg:3: '3d' is not a valid setting name"},
         Malformed{"[a]\nclass TestFunction\nposition 0 0 0\n",
-                  "rp.cfg:3: setting 'position' is not known for class TestFunction (known: qmotorConfig)"},
+                  "rp.cfg:3: setting 'position' is not known for class TestFunction (known: cpu, qmotorConfig, thread)"},
+        Malformed{"[a]\nclass TestArm\nthread mine\n", "rp.cfg:3: setting 'thread' needs 1 value (own, shared), got 'mine'"},
+        Malformed{"[a]\nclass TestArm\nthread\n", "rp.cfg:3: setting 'thread' needs 1 value (own, shared), got 0 values"},
+        Malformed{"[a]\nclass TestArm\ncpu -1\n", "rp.cfg:3: setting 'cpu' needs 1 value, a CPU number in 0..1023, got '-1'"},
+        Malformed{"[a]\nclass TestArm\ncpu 1.5\n", "rp.cfg:3: setting 'cpu' needs 1 value, a CPU number in 0..1023, got '1.5'"},
         Malformed{"[a]\nclass TestArm\nqmotorConfig a.cfg b.cfg\n",
                   "rp.cfg:3: setting 'qmotorConfig' needs 1 value (a file name), got 2"},
         Malformed{"[a]\nclass TestArm\nqmotorConfig rp_no_such_file.cfg\n",
@@ -366,7 +370,7 @@ TEST(SettingSchema, DeclarationsAndKnownNames) {
   EXPECT_EQ(s.find("position")->unit, "mm");
   EXPECT_EQ(s.find("orientation")->unit, "deg");
   EXPECT_EQ(s.find("nothing"), nullptr);
-  EXPECT_EQ(s.knownNames(), "display, orientation, position, qmotorConfig, simulationMode");
+  EXPECT_EQ(s.knownNames(), "cpu, display, orientation, position, qmotorConfig, simulationMode, thread");
 }
 
 TEST(SettingSchema, DefaultsForTheReference) {

@@ -133,5 +133,30 @@ TEST_F(QMotorConfigClasses, AClassThatRunsNoControlProgramRefusesTheFileAtTheRpC
                 "' (only a class that runs one, e.g. derived from ControlProgram, takes the file)");
 }
 
+// rp.cfg's executor settings reach the object's control program before its loop starts: `thread
+// own` gives it a thread of its own, `cpu N` pins it; an object without a control program refuses
+// them at their line.
+TEST_F(QMotorConfigClasses, ThreadAndCpuSettingsReachTheControlProgram) {
+  configure("[filter]\nclass QmFilteredSensor\nthread own\ncpu 0\n", "");
+  {
+    FilteredSensor sensor("filter");
+    EXPECT_TRUE(sensor.isRunning());
+    EXPECT_EQ(sensor.getThreadMode(), ThreadMode::Own);
+    EXPECT_EQ(sensor.getCpuAffinity(), 0);
+    EXPECT_TRUE(sensor.getStatistics().ownThread);
+  }
+  configure("[filter]\nclass QmFilteredSensor\nthread shared\n", "");
+  {
+    FilteredSensor sensor("filter");
+    EXPECT_EQ(sensor.getThreadMode(), ThreadMode::Shared);
+    EXPECT_EQ(sensor.getCpuAffinity(), -1);
+  }
+  configure("[gripper]\nclass DefaultGripper\nthread own\n", "");
+  ObjectManager om;
+  EXPECT_EQ(configError([&] { om.createDerivedObject<Gripper>("gripper"); }),
+            path("rp.cfg") + ":3: setting 'thread': gripper (DefaultGripper) runs no control program, so it has no "
+                             "thread to choose or pin");
+}
+
 }  // namespace
 }  // namespace rp

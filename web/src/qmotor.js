@@ -395,6 +395,16 @@ function showProgramStatus(s) {
   }
   progEl.name.textContent = `${s.program} (${s.rate} Hz)`;
   progEl.state.textContent = s.running ? `running, ${s.cycles} cycles` : `stopped after ${s.cycles} cycles`;
+  if (s.timing && s.timing.executorPrograms > 0) {
+    // Its own computation time, and its executor's wake-up latency and overruns (docs/realtime.md).
+    const t = s.timing;
+    const shared = t.ownThread ? 'own thread' : `executor of ${t.executorPrograms}`;
+    const last = t.lastOverrunProgram ? `, last by ${t.lastOverrunProgram}` : '';
+    progEl.state.title = `computation p50 ${t.computationP50.toFixed(1)} µs, p99 ${t.computationP99.toFixed(1)} µs, ` +
+      `max ${t.computationMax.toFixed(1)} µs; ${shared}: wake-up p99 ${t.wakeupP99.toFixed(1)} µs, ` +
+      `${t.overruns} overruns${last}`;
+    progEl.state.textContent += ` · computation p99 ${t.computationP99.toFixed(1)} µs · ${t.overruns} overruns${last}`;
+  }
   progEl.state.className = s.running ? 'on' : 'off';
   progEl.folder.textContent = s.folder ? `in ${s.folder}` : 'no rp.cfg section: no folder';
   progEl.folder.title = s.configFile ? `qmotorConfig ${s.configFile}` : '';

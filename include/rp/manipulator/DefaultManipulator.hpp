@@ -23,9 +23,11 @@ namespace rp {
 
 class SimulatedClock;
 
-/// A manipulator whose servo loop runs in its own ControlProgram thread, spawned when the object
-/// is created (paper Figure 11). Every cycle:
-/// 1. read the joints (from the arm, or from the dynamic simulation in simulation mode);
+/// A manipulator whose servo loop is a ControlProgram, started when the object is created (paper
+/// Figure 11) and stepped by the executor thread of its rate with every other arm of that rate
+/// (or in a thread of its own: rp.cfg `thread own`; docs/realtime.md, Executors). Every cycle:
+/// 1. read the joints (from the arm, or from the dynamic simulation in simulation mode): the read
+///    phase, readInputs(), before any program of the executor computes;
 /// 2. get the setpoint from the trajectory generator (hold the current position when there is
 ///    none; see the hand-overs below);
 /// 3. run the servo control (a DefaultPositionControl unless switched), plus the gravity torque
@@ -37,7 +39,9 @@ class SimulatedClock;
 ///    number, or an exception thrown by the servo control or the trajectory generator (its
 ///    message in the error status); a joint reading that is not a number switches the power off
 ///    at once;
-/// 5. output the torques (to the amplifiers, or integrate the model's forward dynamics);
+///    (steps 2 to 4 are the control phase, control());
+/// 5. output the torques (to the amplifiers, or integrate the model's forward dynamics): the write
+///    phase, writeOutputs(), after every program of the executor has computed;
 /// 6. publish the state for other threads and sample the log variables `q`, `qd`, `qdes`,
 ///    `qddes`, `qdddes`, `tau`, `saturated` and `missed` (deadlines skipped so far).
 ///
@@ -239,7 +243,17 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
 
  protected:
   void enterControl() override;
+  /// The read phase of the servo cycle: commands from other threads (power, a new setup), then
+  /// the joints (encoders, or the simulation) and the external wrenches. After it, every program
+  /// of the executor that calls getJointPosition() from the executor's thread gets this cycle's
+  /// reading, without a lock.
+  void readInputs() override;
+  /// The compute phase: the setpoint, the servo control, gravity, saturation, the limits and the
+  /// shutdown's hold.
   void control() override;
+  /// The write phase: the torques to the amplifiers (or one step of the simulation), then the
+  /// state for other threads.
+  void writeOutputs() override;
   void exitControl() override;
   /// Rebuilds the model and switches simulation and hardware after a change of pose, mount or
   /// simulation mode (see the class comment).
@@ -339,6 +353,8 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   bool power_ = false;
   double restTime_ = 0, shutdownStart_ = 0;
   double lastCycleTime_ = -1;   // time of the previous cycle (-1 before the first)
+  bool poweredOn_ = false;      // loop: the power came on in this cycle's read phase
+  bool readFailed_ = false;     // loop: this cycle's reading is not a number (control() skipped)
   std::int64_t lastSampleTime_ = 0;  // the board's time of the joints last read [ns] (0: none, or not known)
   double saturatedJoints_ = 0;  // log column `saturated`: joints at their torque limit this cycle
   double missedCycles_ = 0;     // log column `missed`: deadlines skipped so far

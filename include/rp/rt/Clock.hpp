@@ -68,15 +68,16 @@ class SimulatedClock : public Clock {
   void resume();
   /// Whether the clock is paused.
   bool isPaused() const;
-  /// Number of programs running on the clock.
+  /// Number of programs running on the clock (of every executor on it).
   int getNumberOfPrograms() const;
 
   /// @cond INTERNAL
-  // Used by ControlProgram's thread.
+  // Used by the executors' threads (one participant per executor).
   struct Participant {
     std::uint64_t nextTick = 0;
     bool waiting = false;
     const void* owner = nullptr;
+    std::atomic<int> programs{0};  // programs the executor steps
   };
   void attach(Participant& p);
   void detach(Participant& p);

@@ -38,6 +38,33 @@ struct ControlStatistics {
   std::uint64_t lostLogSamples = 0;   ///< log samples dropped because the ring buffer was full
   bool realTimeScheduling = false;    ///< the thread runs with SCHED_FIFO
   bool simulatedClock = false;        ///< the program runs on a simulated clock
+  bool ownThread = false;             ///< the program has a thread of its own (ThreadMode::Own)
+  std::size_t executorPrograms = 0;   ///< programs its executor stepped (itself included) when it joined it
+};
+
+/// How a control program's loop is run (docs/realtime.md, Executors).
+enum class ThreadMode {
+  Shared,  ///< stepped with every program of the same clock, rate, priority and CPU by one thread (the default)
+  Own      ///< in a thread of its own (rp.cfg `thread own`)
+};
+
+/// Statistics of one executor: the thread that steps the programs of one clock, rate, priority
+/// and CPU (ControlProgram::getExecutorStatistics()).
+struct ExecutorStatistics {
+  double rate = 0;                   ///< loop rate [Hz]
+  int priority = 0;                  ///< SCHED_FIFO priority
+  int cpu = -1;                      ///< CPU it is pinned to, or -1
+  bool ownThread = false;            ///< a program's thread of its own (ThreadMode::Own)
+  bool simulatedClock = false;       ///< runs on a simulated clock
+  bool realTimeScheduling = false;   ///< the thread runs with SCHED_FIFO
+  std::vector<std::string> programs;  ///< the programs it steps, in their order within each phase
+  std::uint64_t cycles = 0;          ///< cycles run
+  std::uint64_t overruns = 0;        ///< cycles that ended after the next deadline
+  std::uint64_t missedCycles = 0;    ///< deadlines skipped because of overruns
+  LatencyStatistics wakeupLatency;   ///< how late the thread woke after each deadline (real clock)
+  LatencyStatistics cycleTime;       ///< time from the wake-up to the end of the cycle's last phase
+  std::string lastOverrunProgram;    ///< the program that took the most time in the last overrun ("" if none)
+  double lastOverrunProgramTime = 0;  ///< its computation time in that cycle [µs]
 };
 
 /// A registered log variable (name and size fixed at configure time).
@@ -84,18 +111,25 @@ struct LogCaptureStatus {
   bool triggerRising = true;         ///< as set
 };
 
-/// A periodic control loop in its own thread (QMotor's ControlProgram).
+/// A periodic control loop (QMotor's ControlProgram), stepped by an executor thread.
 ///
 /// Derive from it and implement control(); register log variables and parameters in the
-/// constructor (before start()). start() spawns the thread, which runs at the set rate on its
-/// clock: on the real clock with absolute deadlines (`clock_nanosleep`, TIMER_ABSTIME), with
-/// `mlockall` and SCHED_FIFO at the set priority when the process may (otherwise one warning
-/// and normal scheduling); on a SimulatedClock in lockstep with the other programs on it.
+/// constructor (before start()). start() hands the program to an executor: one periodic thread
+/// that steps every program of the same clock, rate, priority and CPU (ThreadMode::Shared, the
+/// default), or a thread of the program's own (setThreadMode(ThreadMode::Own), rp.cfg
+/// `thread own`). The thread runs at the set rate on its clock: on the real clock with absolute
+/// deadlines (`clock_nanosleep`, TIMER_ABSTIME), with `mlockall` and SCHED_FIFO at the set
+/// priority when the process may (otherwise one warning and normal scheduling); on a
+/// SimulatedClock in lockstep with the other executors on it.
 ///
-/// Each cycle: wait for the deadline; apply parameter changes requested since the last cycle;
-/// call control(); sample the log variables every getLogEvery()-th cycle into a preallocated
-/// ring buffer read by a LogWriter's non-real-time thread. Nothing in the cycle allocates, locks
-/// or does I/O (tests/realtime/rt_alloc_test.cpp proves it).
+/// Each cycle of an executor: wait for the deadline; then in three phases, each over every
+/// program in the order they were started: apply parameter changes and readInputs(); control();
+/// writeOutputs(); then sample each program's log variables every getLogEvery()-th cycle into a
+/// preallocated ring buffer read by a LogWriter's non-real-time thread. So the control() of
+/// every program of an executor sees the inputs every other program read in the same cycle
+/// (for a manipulator: its joints; DefaultManipulator::getJointPosition() from the executor's
+/// thread returns them without a lock). Nothing in the cycle allocates, locks or does I/O
+/// (tests/realtime/rt_alloc_test.cpp proves it).
 ///
 /// A derived class whose control() uses its own members must call stop() in its destructor.
 class ControlProgram {
@@ -153,6 +187,20 @@ class ControlProgram {
   /// Stops the loop by itself after `cycles` cycles (0: never, the default).
   /// @param[in] cycles  number of cycles
   void setCycleLimit(std::uint64_t cycles);
+  /// Chooses between the shared executor of the program's clock, rate, priority and CPU
+  /// (ThreadMode::Shared) and a thread of its own (ThreadMode::Own). Default:
+  /// getDefaultThreadMode() at construction.
+  /// @param[in] mode  the thread mode
+  /// @throws std::logic_error if running
+  void setThreadMode(ThreadMode mode);
+  /// The thread mode.
+  ThreadMode getThreadMode() const;
+  /// Sets the thread mode of programs constructed from now on (default ThreadMode::Shared, or
+  /// ThreadMode::Own when the environment variable `RP_CONTROL_THREADS` is `own`).
+  /// @param[in] mode  the thread mode
+  static void setDefaultThreadMode(ThreadMode mode);
+  /// The thread mode of programs constructed from now on.
+  static ThreadMode getDefaultThreadMode();
   /// @}
 
   /// @name Running
@@ -183,6 +231,8 @@ class ControlProgram {
   std::uint64_t getMissedCycleCount() const noexcept;
   /// Statistics since start(). Real-time safe: no.
   ControlStatistics getStatistics() const;
+  /// Statistics of every executor running now, in the order they were created. Real-time safe: no.
+  static std::vector<ExecutorStatistics> getExecutorStatistics();
   /// @}
 
   /// @name Log variables (register before start())
@@ -333,16 +383,27 @@ class ControlProgram {
   static void stopAll();
 
  protected:
-  /// Called in the loop thread before the first cycle (not time-critical).
+  /// Called in the loop thread before the program's first cycle (not time-critical, but with a
+  /// shared executor it delays that cycle of every program of the executor).
   virtual void enterControl() {}
-  /// One control cycle. Must not allocate, lock or do I/O. Real-time safe: must be.
+  /// The read phase of a cycle: read the program's inputs (sensors, encoders). Runs before the
+  /// control() of every program of the executor. Default: nothing. Real-time safe: must be.
+  virtual void readInputs() {}
+  /// One control cycle (the compute phase), after the readInputs() of every program of the
+  /// executor and before their writeOutputs(). Must not allocate, lock or do I/O. Real-time
+  /// safe: must be.
   virtual void control() = 0;
+  /// The write phase of a cycle: write the program's outputs (actuators), after the control()
+  /// of every program of the executor. Default: nothing. Real-time safe: must be.
+  virtual void writeOutputs() {}
   /// Called in the loop thread after the last cycle.
   virtual void exitControl() {}
 
  private:
   struct Impl;
+  struct Executor;
   friend struct Impl;
+  friend struct Executor;
   std::unique_ptr<Impl> impl_;
 };
 

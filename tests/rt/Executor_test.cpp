@@ -1,0 +1,338 @@
+// Executors: programs of one clock, rate, priority and CPU stepped by one thread in three phases
+// (read, control, write); a thread of its own on request; adding and removing programs while the
+// executor runs; lockstep of several executors on a simulated clock; overruns named after the
+// program that took the time. No timing thresholds: the simulated clock gives exact cycles.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rp/rt/Clock.hpp"
+#include "rp/rt/ControlProgram.hpp"
+
+namespace rp {
+namespace {
+
+// A journal of phase calls, written only by executor threads (preallocated; one entry per call).
+struct Journal {
+  explicit Journal(std::size_t capacity) { entries.resize(capacity); }
+  struct Entry {
+    int program = -1;
+    char phase = 0;  // 'r', 'c', 'w'
+    std::uint64_t cycle = 0;
+    std::thread::id thread;
+  };
+  void add(int program, char phase, std::uint64_t cycle) noexcept {
+    const std::size_t i = size.fetch_add(1);
+    if (i < entries.size()) entries[i] = Entry{program, phase, cycle, std::this_thread::get_id()};
+  }
+  std::vector<Entry> entries;
+  std::atomic<std::size_t> size{0};
+};
+
+// Journals its phases; `measured` is its "sensor" (its cycle count, read in the read phase), and
+// `seen` what it read of another program's sensor in its control().
+class Phased : public ControlProgram {
+ public:
+  Phased(const std::string& name, int id, Journal* journal) : ControlProgram(name), id_(id), journal_(journal) {
+    registerLogVariable("measured", measured);
+    registerLogVariable("seen", seen);
+  }
+  ~Phased() override { stop(); }
+  const Phased* watch = nullptr;
+  double measured = -1, seen = -1;
+  std::atomic<long> mismatches{0};  // cycles in which `seen` was not the watched program's sensor of this cycle
+  std::atomic<long> compared{0};
+
+ protected:
+  void readInputs() override {
+    measured = static_cast<double>(getCycleCount());
+    if (journal_ != nullptr) journal_->add(id_, 'r', getCycleCount());
+  }
+  void control() override {
+    if (journal_ != nullptr) journal_->add(id_, 'c', getCycleCount());
+    if (watch != nullptr) {
+      seen = watch->measured;
+      // Both started together: the watched program's cycle k is this one's cycle k.
+      if (getCycleCount() >= 1) {
+        compared.fetch_add(1);
+        if (seen != static_cast<double>(getCycleCount())) mismatches.fetch_add(1);
+      }
+    }
+  }
+  void writeOutputs() override {
+    if (journal_ != nullptr) journal_->add(id_, 'w', getCycleCount());
+  }
+
+ private:
+  int id_;
+  Journal* journal_;
+};
+
+std::size_t executorsWith(const std::string& program) {
+  std::size_t n = 0;
+  for (const auto& e : ControlProgram::getExecutorStatistics())
+    for (const auto& p : e.programs) n += p == program;
+  return n;
+}
+
+TEST(Executor, ProgramsOfOneRateShareOneThreadAndRunInPhases) {
+  SimulatedClock clock(1e-3, true);
+  Journal journal(3 * 3 * 20);
+  Phased a("a", 0, &journal), b("b", 1, &journal), c("c", 2, &journal);
+  for (Phased* p : {&a, &b, &c}) {
+    EXPECT_EQ(p->getThreadMode(), ThreadMode::Shared);
+    p->setClock(clock);
+    p->setCycleLimit(20);
+    p->start();
+  }
+  // One executor steps all three, in the order they were started.
+  const auto stats = ControlProgram::getExecutorStatistics();
+  const ExecutorStatistics* shared = nullptr;
+  for (const auto& e : stats)
+    if (!e.programs.empty() && e.programs[0] == "a") shared = &e;
+  ASSERT_NE(shared, nullptr);
+  EXPECT_EQ(shared->programs, (std::vector<std::string>{"a", "b", "c"}));
+  EXPECT_FALSE(shared->ownThread);
+  EXPECT_TRUE(shared->simulatedClock);
+  clock.resume();
+  for (Phased* p : {&a, &b, &c}) p->waitUntilStopped();
+  EXPECT_EQ(a.getStatistics().executorPrograms, 1u);  // when each joined
+  EXPECT_EQ(c.getStatistics().executorPrograms, 3u);
+
+  ASSERT_EQ(journal.size.load(), 3u * 3u * 20u);
+  const std::thread::id thread = journal.entries[0].thread;
+  EXPECT_NE(thread, std::this_thread::get_id());
+  // Tick 0: the executor may have run it before b and c joined (the clock's current tick runs
+  // at once, paused or not); then each ran it in a catch-up cycle. Every program ran it once,
+  // in its phase order, in the executor's thread; from tick 1 on all three are stepped together.
+  std::size_t i = 0;
+  for (; i < 9; ++i) {
+    const auto& e = journal.entries[i];
+    EXPECT_EQ(e.cycle, 0u) << "entry " << i;
+    EXPECT_EQ(e.thread, thread) << "entry " << i;
+  }
+  for (int program = 0; program < 3; ++program) {
+    std::string phases;
+    for (std::size_t k = 0; k < 9; ++k)
+      if (journal.entries[k].program == program) phases += journal.entries[k].phase;
+    EXPECT_EQ(phases, "rcw") << "program " << program;
+  }
+  for (std::uint64_t cycle = 1; cycle < 20; ++cycle)
+    for (char phase : {'r', 'c', 'w'})
+      for (int program = 0; program < 3; ++program, ++i) {
+        const auto& e = journal.entries[i];
+        EXPECT_EQ(e.program, program) << "entry " << i;
+        EXPECT_EQ(e.phase, phase) << "entry " << i;
+        EXPECT_EQ(e.cycle, cycle) << "entry " << i;
+        EXPECT_EQ(e.thread, thread) << "entry " << i;
+      }
+  EXPECT_EQ(clock.getTick(), 19u);  // the clock stops with the last program
+}
+
+TEST(Executor, ThreadOwnGivesEachProgramItsOwnThread) {
+  SimulatedClock clock(1e-3, true);
+  Journal journal(2 * 3 * 10);
+  Phased a("own_a", 0, &journal), b("own_b", 1, &journal);
+  for (Phased* p : {&a, &b}) {
+    p->setThreadMode(ThreadMode::Own);
+    p->setClock(clock);
+    p->setCycleLimit(10);
+    p->start();
+  }
+  EXPECT_THROW(a.setThreadMode(ThreadMode::Shared), std::logic_error);
+  std::size_t own = 0;
+  for (const auto& e : ControlProgram::getExecutorStatistics())
+    if (e.ownThread && e.programs.size() == 1 && (e.programs[0] == "own_a" || e.programs[0] == "own_b")) ++own;
+  EXPECT_EQ(own, 2u);
+  clock.resume();
+  a.waitUntilStopped();
+  b.waitUntilStopped();
+  EXPECT_TRUE(a.getStatistics().ownThread);
+  ASSERT_EQ(journal.size.load(), 2u * 3u * 10u);
+  std::thread::id threads[2];
+  for (std::size_t i = 0; i < journal.size.load(); ++i) threads[journal.entries[i].program] = journal.entries[i].thread;
+  EXPECT_NE(threads[0], threads[1]);
+  EXPECT_EQ(a.getCycleCount(), 10u);
+  EXPECT_EQ(b.getCycleCount(), 10u);
+  EXPECT_EQ(executorsWith("own_a"), 0u);  // stopped: no executor steps it any more
+}
+
+TEST(Executor, DefaultThreadModeAppliesToNewPrograms) {
+  const ThreadMode before = ControlProgram::getDefaultThreadMode();
+  ControlProgram::setDefaultThreadMode(ThreadMode::Own);
+  Phased a("default_own", 0, nullptr);
+  ControlProgram::setDefaultThreadMode(ThreadMode::Shared);
+  Phased b("default_shared", 1, nullptr);
+  ControlProgram::setDefaultThreadMode(before);
+  EXPECT_EQ(a.getThreadMode(), ThreadMode::Own);
+  EXPECT_EQ(b.getThreadMode(), ThreadMode::Shared);
+}
+
+// The same-cycle guarantee: the reader, started first (stepped first in every phase), sees in its
+// control() the sensor the other program read in the same cycle. Without the phases (each
+// program's read, control and write in turn) it would see the previous cycle's. (Tick 0 may run
+// before the sensor has joined: compared from cycle 1 on.)
+TEST(Executor, ControlSeesEveryInputOfTheSameCycleWhateverTheOrder) {
+  SimulatedClock clock(1e-3, true);
+  Phased reader("reader", 0, nullptr), sensor("sensor", 1, nullptr);
+  reader.watch = &sensor;
+  for (Phased* p : {&reader, &sensor}) {
+    p->setClock(clock);
+    p->setCycleLimit(200);
+    p->start();
+  }
+  clock.resume();
+  reader.waitUntilStopped();
+  sensor.waitUntilStopped();
+  EXPECT_EQ(reader.compared.load(), 199);
+  EXPECT_EQ(reader.mismatches.load(), 0);
+  EXPECT_EQ(reader.seen, 199);
+}
+
+// A thread of its own gives no such guarantee (the two threads run concurrently); this only
+// checks that both ran every cycle in lockstep on the simulated clock.
+TEST(Executor, ExecutorsOfOneSimulatedClockRunInLockstep) {
+  SimulatedClock clock(1e-3, true);
+  Phased fast("fast", 0, nullptr), slow("slow", 1, nullptr), own("alone", 2, nullptr);
+  fast.setRate(1000);
+  slow.setRate(250);
+  own.setRate(1000);
+  own.setThreadMode(ThreadMode::Own);
+  for (Phased* p : {&fast, &slow, &own}) p->setClock(clock);
+  fast.setCycleLimit(100);
+  slow.setCycleLimit(25);
+  own.setCycleLimit(100);
+  for (Phased* p : {&fast, &slow, &own}) p->start();
+  clock.resume();
+  for (Phased* p : {&fast, &slow, &own}) p->waitUntilStopped();
+  EXPECT_EQ(fast.getCycleCount(), 100u);
+  EXPECT_EQ(slow.getCycleCount(), 25u);
+  EXPECT_EQ(own.getCycleCount(), 100u);
+  EXPECT_DOUBLE_EQ(fast.getTime(), 0.099);
+  EXPECT_DOUBLE_EQ(slow.getTime(), 0.096);
+  EXPECT_DOUBLE_EQ(own.getTime(), 0.099);
+}
+
+// Programs join and leave a running executor; the others go on without missing a cycle.
+TEST(Executor, ProgramsJoinAndLeaveARunningExecutor) {
+  SimulatedClock clock(1e-3);
+  Phased first("first", 0, nullptr);
+  first.setClock(clock);
+  first.start();
+  std::vector<std::unique_ptr<Phased>> others;
+  for (int i = 0; i < 8; ++i) {
+    others.push_back(std::make_unique<Phased>("joiner" + std::to_string(i), i + 1, nullptr));
+    others.back()->setClock(clock);
+    others.back()->start();
+  }
+  EXPECT_EQ(executorsWith("first"), 1u);
+  for (int round = 0; round < 20; ++round) {
+    // Remove one, start it again, while the executor keeps stepping the rest.
+    Phased& p = *others[static_cast<std::size_t>(round) % others.size()];
+    const std::uint64_t before = first.getCycleCount();
+    p.stop();
+    EXPECT_FALSE(p.isRunning());
+    p.start();
+    while (first.getCycleCount() < before + 3) std::this_thread::yield();
+  }
+  for (auto& p : others) {
+    const std::uint64_t k = p->getCycleCount();
+    while (p->getCycleCount() < k + 2) std::this_thread::yield();
+  }
+  // `first` never left: its cycles are consecutive ticks (the clock only advances when it ran).
+  others.clear();
+  first.stop();
+  EXPECT_EQ(first.getStatistics().missedCycles, 0u);
+  EXPECT_NEAR(first.getTime(), static_cast<double>(first.getCycleCount() - 1) * 1e-3, 1e-9);
+  EXPECT_EQ(executorsWith("first"), 0u);
+}
+
+// A program stopped from another program's cycle (its executor's thread) ends after the cycle;
+// the others go on.
+class Stopper : public ControlProgram {
+ public:
+  Stopper(ControlProgram& victim, std::uint64_t at) : ControlProgram("stopper"), victim_(victim), at_(at) {}
+  ~Stopper() override { stop(); }
+
+ protected:
+  void control() override {
+    if (getCycleCount() == at_) victim_.stop();  // from the executor's thread: only asks
+  }
+
+ private:
+  ControlProgram& victim_;
+  std::uint64_t at_;
+};
+
+TEST(Executor, StopFromTheExecutorsThreadOnlyAsks) {
+  SimulatedClock clock(1e-3, true);
+  Phased victim("victim", 0, nullptr);
+  Stopper stopper(victim, 10);
+  victim.setClock(clock);
+  stopper.setClock(clock);
+  stopper.setCycleLimit(30);
+  victim.start();
+  stopper.start();
+  clock.resume();
+  stopper.waitUntilStopped();
+  victim.waitUntilStopped();
+  EXPECT_EQ(victim.getCycleCount(), 11u);  // cycle 10 completed, then it ended
+  EXPECT_EQ(stopper.getCycleCount(), 30u);
+}
+
+// On the real clock a cycle that overruns is counted for the executor and named after the program
+// that took the time (from cycle 5 on, a busy wait of 20 periods in every cycle: an overrun
+// however fast the machine is, and the other program's few microseconds never the larger).
+class Busy : public ControlProgram {
+ public:
+  Busy(const std::string& name, std::uint64_t busyCycle) : ControlProgram(name), busyCycle_(busyCycle) {}
+  ~Busy() override { stop(); }
+
+ protected:
+  void control() override {
+    if (getCycleCount() < busyCycle_) return;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long>(20e6 / getRate()));
+    while (std::chrono::steady_clock::now() < until) {
+    }
+  }
+
+ private:
+  std::uint64_t busyCycle_;
+};
+
+TEST(Executor, AnOverrunIsNamedAfterTheProgramThatTookTheTime) {
+  Busy idle("idle", ~std::uint64_t{0}), hog("hog", 5);
+  for (Busy* p : {&idle, &hog}) {
+    p->setClock(RealClock::instance());
+    p->setRate(500);
+    p->setPriority(11);  // an executor of its own among the tests' (rate and priority)
+    p->setCycleLimit(10);
+    p->start();
+  }
+  bool found = false;
+  ExecutorStatistics seen;
+  while (hog.getCycleCount() < 7) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  for (const auto& e : ControlProgram::getExecutorStatistics())
+    if (e.programs == std::vector<std::string>{"idle", "hog"}) {
+      found = true;
+      seen = e;
+    }
+  idle.waitUntilStopped();
+  hog.waitUntilStopped();
+  ASSERT_TRUE(found);
+  EXPECT_GE(seen.overruns, 1u);
+  EXPECT_GE(seen.missedCycles, 1u);
+  EXPECT_EQ(seen.lastOverrunProgram, "hog");
+  EXPECT_GT(seen.lastOverrunProgramTime, 0);
+  EXPECT_GE(seen.wakeupLatency.count, 1u);
+  EXPECT_GE(hog.getStatistics().overruns, 1u);
+  EXPECT_GE(idle.getStatistics().overruns, 1u);  // every program of the executor missed the deadline
+  EXPECT_GE(hog.getStatistics().computationTime.max, idle.getStatistics().computationTime.max);
+}
+
+}  // namespace
+}  // namespace rp
