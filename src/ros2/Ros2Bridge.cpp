@@ -6,9 +6,9 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <mutex>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -31,15 +31,41 @@ namespace {
 
 constexpr int kMaxDomain = 230;  // Cyclone DDS's largest domain id with the default port mapping
 
-// A ROS name part: letters, digits and '_', not starting with a digit.
+// A ROS namespace: parts of letters, digits and '_', not starting with a digit, between '/'.
+// (Hand-written: GCC 12's std::regex trips -Wmaybe-uninitialized in the sanitizer builds.)
 bool validNamespace(const std::string& ns) {
-  static const std::regex re("/?([A-Za-z_][A-Za-z0-9_]*)(/[A-Za-z_][A-Za-z0-9_]*)*/?");
-  return ns.empty() || (ns.size() <= 200 && std::regex_match(ns, re));
+  if (ns.size() > 200) return false;
+  std::size_t begin = ns.empty() || ns.front() != '/' ? 0 : 1;
+  std::size_t end = ns.size();
+  if (end > begin && ns[end - 1] == '/') --end;
+  if (begin >= end) return ns.empty();
+  std::size_t partStart = begin;
+  for (std::size_t i = begin; i <= end; ++i) {
+    if (i == end || ns[i] == '/') {
+      if (i == partStart) return false;  // empty part: "a//b"
+      partStart = i + 1;
+      continue;
+    }
+    const auto c = static_cast<unsigned char>(ns[i]);
+    if (!(std::isalnum(c) || c == '_') || (i == partStart && std::isdigit(c))) return false;
+  }
+  return true;
 }
 
 bool validInterface(const std::string& name) {
-  static const std::regex re("[A-Za-z0-9_.:@-]{1,40}");
-  return std::regex_match(name, re);
+  if (name.empty() || name.size() > 40) return false;
+  for (char ch : name) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (!(std::isalnum(c) || c == '_' || c == '.' || c == ':' || c == '@' || c == '-')) return false;
+  }
+  return true;
+}
+
+bool isIpv4Address(const std::string& text) {
+  if (text.empty()) return false;
+  for (char c : text)
+    if (!(std::isdigit(static_cast<unsigned char>(c)) || c == '.')) return false;
+  return true;
 }
 
 // A ROS name made of an object name (rp allows more characters than ROS names).
@@ -272,7 +298,7 @@ std::string Ros2Bridge::cycloneConfig(const std::vector<std::string>& interfaces
   if (!any) {
     x << "<General><Interfaces>";
     for (const std::string& i : interfaces) {
-      const bool address = std::regex_match(i, std::regex("[0-9.]+"));
+      const bool address = isIpv4Address(i);
       x << "<NetworkInterface " << (address ? "address" : "name") << "=\"" << i << "\"/>";
     }
     x << "</Interfaces>";
@@ -289,20 +315,32 @@ std::string Ros2Bridge::cycloneConfig(const std::vector<std::string>& interfaces
 }
 
 std::string Ros2Bridge::prefixUrdf(const std::string& object, const std::string& urdf) {
-  static const std::regex names("(<(?:link|joint|transmission|actuator) name=\"|<(?:parent|child) link=\")([^\"]*)\"");
+  static const char* const kNameAttributes[] = {"<link name=\"",         "<joint name=\"",  "<transmission name=\"",
+                                                "<actuator name=\"",     "<parent link=\"", "<child link=\""};
   const std::string prefix = rosName(object) + "_";
   std::string out;
-  auto begin = std::sregex_iterator(urdf.begin(), urdf.end(), names);
-  std::size_t last = 0;
-  for (auto it = begin; it != std::sregex_iterator(); ++it) {
-    const std::smatch& m = *it;
-    out.append(urdf, last, static_cast<std::size_t>(m.position(0)) - last);
-    out += m.str(1);
-    out += m.str(2) == "world" ? m.str(2) : prefix + m.str(2);
-    out += '"';
-    last = static_cast<std::size_t>(m.position(0) + m.length(0));
+  out.reserve(urdf.size() + urdf.size() / 8);
+  std::size_t at = 0;
+  for (;;) {
+    std::size_t next = std::string::npos, length = 0;  // the earliest name attribute from `at`
+    for (const char* a : kNameAttributes) {
+      const std::size_t p = urdf.find(a, at);
+      if (p < next) {
+        next = p;
+        length = std::strlen(a);
+      }
+    }
+    if (next == std::string::npos) break;
+    const std::size_t nameStart = next + length;
+    const std::size_t nameEnd = urdf.find('"', nameStart);
+    if (nameEnd == std::string::npos) break;
+    out.append(urdf, at, nameStart - at);
+    const std::string name = urdf.substr(nameStart, nameEnd - nameStart);
+    if (name != "world") out += prefix;
+    out += name;
+    at = nameEnd;
   }
-  out.append(urdf, last, std::string::npos);
+  out.append(urdf, at, std::string::npos);
   return out;
 }
 
