@@ -13,3 +13,4 @@
 #include "rp/io/Io.hpp"
 #include "rp/effector/Effector.hpp"
 #include "rp/gui/SceneViewer.hpp"
+#include "rp/ros2/Ros2Bridge.hpp"

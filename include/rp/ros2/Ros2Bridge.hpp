@@ -1,0 +1,113 @@
+#pragma once
+/// @file
+/// The ROS 2 bridge: the process's manipulators published on DDS (Cyclone DDS) with ROS 2's wire
+/// conventions, so that ROS 2 nodes (RViz, ros2 topic, MoveIt) on the same network see them
+/// without a bridge node. See docs/ros2.md.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rp/core/PhysicalObject.hpp"
+
+namespace rp {
+
+/// Settings of a Ros2Bridge made in code (rp.cfg has the same ones, see Ros2Bridge).
+struct Ros2BridgeOptions {
+  int domain = 0;          ///< DDS domain id (ROS_DOMAIN_ID), 0..230
+  /// ROS namespace of every topic, e.g. `cell1` or `/lab/cell1` (empty: none); letters, digits,
+  /// `_` and `/`, each part starting with a letter or `_`.
+  std::string nameSpace;
+  double rate = 50;        ///< joint_states and tf samples per second [Hz], 1..1000
+  /// Network interfaces DDS may use (Linux names such as `eth0`, or IPv4 addresses); `{"lo"}`
+  /// (the default) keeps DDS on this machine; `{"any"}` lets Cyclone DDS choose.
+  std::vector<std::string> interfaces{"lo"};
+};
+
+/// Counters of a running bridge (samples written since it started), for tests and diagnostics.
+struct Ros2BridgeStatistics {
+  std::uint64_t cycles = 0;         ///< publishing cycles run
+  std::uint64_t jointStates = 0;    ///< sensor_msgs/JointState samples written (one per arm and cycle)
+  std::uint64_t tf = 0;             ///< tf2_msgs/TFMessage samples written on `tf`
+  std::uint64_t descriptions = 0;   ///< std_msgs/String samples written on the robot_description topics
+  std::uint64_t states = 0;         ///< std_msgs/String samples written on the `<object>/state` topics
+  std::uint64_t writeFailures = 0;  ///< dds_write calls that failed
+  std::size_t manipulators = 0;     ///< manipulators published in the last cycle
+};
+
+/// Publishes every manipulator of the process on DDS as ROS 2 does (rmw_cyclonedds conventions:
+/// topic names `rt/` + namespace + topic, type names `pkg::msg::dds_::Type_`, XCDR1, ROS 2's
+/// default QoS: reliable, volatile, keep-last 10; transient-local for robot_description and
+/// tf_static). Topics, relative to the namespace:
+/// | topic | type | what |
+/// |---|---|---|
+/// | `joint_states` | sensor_msgs/msg/JointState | one sample per arm and cycle: names `<object>_<joint>` (`puma_joint1`, ...), position, velocity, effort (the torque commanded) |
+/// | `tf` | tf2_msgs/msg/TFMessage | world to each link frame of every arm (`<object>_link1`, ..., `<object>_tool`, the end-effector), the frames of the arm's robot_description |
+/// | `tf_static` | tf2_msgs/msg/TFMessage | world to each arm's `<object>_base_link` (transient-local) |
+/// | `robot_description` | std_msgs/msg/String | one URDF holding every arm (transient-local) |
+/// | `<object>/robot_description` | std_msgs/msg/String | the arm's URDF (transient-local) |
+/// | `<object>/state` | std_msgs/msg/String | JSON: arm power, error, system shutdown; when it changes and once a second |
+///
+/// The bridge's own thread samples the arms `rate` times a second from the snapshots their servo
+/// threads publish (as the Scene Viewer does): a servo loop never waits for the bridge or the
+/// network. Arms created after the bridge are published from the next cycle on.
+///
+/// rp.cfg (`[ros]` + `class Ros2Bridge`):
+/// | setting | meaning |
+/// |---|---|
+/// | `domain D` | DDS domain id 0..230 (default 0) |
+/// | `namespace NS` | ROS namespace of the topics (default none) |
+/// | `rate HZ` | joint_states and tf rate 1..1000 Hz (default 50) |
+/// | `interfaces IF...` | network interfaces for DDS (default `lo`: this machine only; `any`: Cyclone's choice) |
+class Ros2Bridge : public FunctionalObject {
+ public:
+  /// Creates the bridge from its rp.cfg section (defaults without one) and starts publishing.
+  /// @param[in] name  object name (rp.cfg section); empty for an automatic name
+  /// @throws ConfigError naming the file and line of a bad setting, or of `interfaces` when DDS
+  ///         cannot start on them
+  /// Real-time safe: no.
+  explicit Ros2Bridge(const std::string& name = "");
+  /// Creates the bridge with settings from code (rp.cfg is not read) and starts publishing.
+  /// @param[in] name     object name; empty for an automatic name
+  /// @param[in] options  domain, namespace, rate, interfaces
+  /// @throws std::invalid_argument for a setting out of range, std::runtime_error when DDS
+  ///         cannot start
+  /// Real-time safe: no.
+  Ros2Bridge(const std::string& name, const Ros2BridgeOptions& options);
+  /// Stops publishing and leaves the DDS domain. Real-time safe: no.
+  ~Ros2Bridge() override;
+
+  /// Declares `domain`, `namespace`, `rate` and `interfaces`.
+  /// @param[out] schema  schema to add to
+  static void declareSettings(SettingSchema& schema);
+
+  /// The settings in use.
+  const Ros2BridgeOptions& getOptions() const noexcept;
+  /// Counters since the bridge started. Real-time safe: yes.
+  Ros2BridgeStatistics getStatistics() const noexcept;
+
+  /// The DDS topic name of ROS topic `topic` in namespace `nameSpace`: `rt/NS/TOPIC`.
+  /// @param[in] nameSpace  ROS namespace (leading and trailing `/` ignored; empty: none)
+  /// @param[in] topic      topic relative to the namespace, e.g. `joint_states`
+  static std::string ddsTopicName(const std::string& nameSpace, const std::string& topic);
+  /// The Cyclone DDS configuration (XML) that restricts a domain to `interfaces` (see
+  /// Ros2BridgeOptions::interfaces).
+  /// @param[in] interfaces  interface names or IPv4 addresses; `{"any"}` for no restriction
+  static std::string cycloneConfig(const std::vector<std::string>& interfaces);
+  /// Why `options` cannot be used ("" if they can): the first setting out of range.
+  /// @param[in] options  settings to check
+  static std::string checkOptions(const Ros2BridgeOptions& options);
+  /// The arm's URDF as the bridge publishes it: toUrdf() with every link and joint name but the
+  /// root `world` prefixed with `<object>_`.
+  /// @param[in] object  the arm's object name
+  /// @param[in] urdf    toUrdf() of its model
+  static std::string prefixUrdf(const std::string& object, const std::string& urdf);
+
+ private:
+  void start();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rp

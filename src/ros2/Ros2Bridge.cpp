@@ -1,0 +1,542 @@
+#include "rp/ros2/Ros2Bridge.hpp"
+
+#include <dds/dds.h>
+
+#include <atomic>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "geometry_msgs.h"
+#include "rp/core/ObjectManager.hpp"
+#include "rp/core/TypeDatabase.hpp"
+#include "rp/manipulator/Manipulator.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/model/ManipulatorData.hpp"
+#include "rp/model/UrdfExport.hpp"
+#include "sensor_msgs.h"
+#include "std_msgs.h"
+#include "tf2_msgs.h"
+
+namespace rp {
+
+namespace {
+
+constexpr int kMaxDomain = 230;  // Cyclone DDS's largest domain id with the default port mapping
+
+// A ROS namespace: parts of letters, digits and '_', not starting with a digit, between '/'.
+// (Hand-written: GCC 12's std::regex trips -Wmaybe-uninitialized in the sanitizer builds.)
+bool validNamespace(const std::string& ns) {
+  if (ns.size() > 200) return false;
+  std::size_t begin = ns.empty() || ns.front() != '/' ? 0 : 1;
+  std::size_t end = ns.size();
+  if (end > begin && ns[end - 1] == '/') --end;
+  if (begin >= end) return ns.empty();
+  std::size_t partStart = begin;
+  for (std::size_t i = begin; i <= end; ++i) {
+    if (i == end || ns[i] == '/') {
+      if (i == partStart) return false;  // empty part: "a//b"
+      partStart = i + 1;
+      continue;
+    }
+    const auto c = static_cast<unsigned char>(ns[i]);
+    if (!(std::isalnum(c) || c == '_') || (i == partStart && std::isdigit(c))) return false;
+  }
+  return true;
+}
+
+bool validInterface(const std::string& name) {
+  if (name.empty() || name.size() > 40) return false;
+  for (char ch : name) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (!(std::isalnum(c) || c == '_' || c == '.' || c == ':' || c == '@' || c == '-')) return false;
+  }
+  return true;
+}
+
+bool isIpv4Address(const std::string& text) {
+  if (text.empty()) return false;
+  for (char c : text)
+    if (!(std::isdigit(static_cast<unsigned char>(c)) || c == '.')) return false;
+  return true;
+}
+
+// A ROS name made of an object name (rp allows more characters than ROS names).
+std::string rosName(const std::string& name) {
+  std::string out;
+  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' ? c : '_';
+  if (out.empty() || std::isdigit(static_cast<unsigned char>(out[0]))) out = "_" + out;
+  return out;
+}
+
+std::string joined(const std::vector<std::string>& words) {
+  std::string out;
+  for (const std::string& w : words) out += (out.empty() ? "" : " ") + w;
+  return out;
+}
+
+std::string ddsError(dds_return_t r) { return dds_strretcode(r); }
+
+builtin_interfaces_msg_dds__Time_ now() {
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                      std::chrono::system_clock::now().time_since_epoch())
+                      .count();
+  builtin_interfaces_msg_dds__Time_ t{};
+  t.sec = static_cast<int32_t>(ns / 1000000000);
+  t.nanosec = static_cast<uint32_t>(ns % 1000000000);
+  return t;
+}
+
+// Quaternion (x, y, z, w) of a rotation matrix, w >= 0.
+void toQuaternion(const Transform& t, geometry_msgs_msg_dds__Quaternion_& q) {
+  const Eigen::Matrix3d R = t.topLeftCorner<3, 3>();
+  Eigen::Quaterniond e(R);
+  e.normalize();
+  if (e.w() < 0) e.coeffs() *= -1;
+  q.x = e.x();
+  q.y = e.y();
+  q.z = e.z();
+  q.w = e.w();
+}
+
+}  // namespace
+
+// One arm as the bridge publishes it.
+struct ArmEntry {
+  std::string name;      // object name
+  std::string rosName;   // the name in frames, joints and topics
+  std::vector<std::string> jointNames;
+  std::vector<std::string> frameNames;  // link1..n, tool
+  std::vector<Transform> frameFromModel;  // frame k = model link frame k * this (URDF link frames)
+  std::unique_ptr<ManipulatorData> data;
+  dds_entity_t stateWriter = 0;
+  dds_entity_t descriptionWriter = 0;
+  std::string urdf;
+  std::string lastState;
+  std::chrono::steady_clock::time_point lastStateTime;
+  bool seen = false;
+};
+
+struct Ros2Bridge::Impl {
+  Ros2BridgeOptions options;
+  std::string nameSpace;  // without leading and trailing '/'
+  dds_entity_t domain = 0;
+  bool ownDomain = false;
+  dds_entity_t participant = 0;
+  std::map<std::string, dds_entity_t> topics;
+  dds_entity_t jointStates = 0, tf = 0, tfStatic = 0, description = 0;
+  std::map<const RoboticObject*, ArmEntry> arms;
+  std::atomic<std::uint64_t> cycles{0}, jointStatesWritten{0}, tfWritten{0}, descriptions{0}, states{0}, failures{0};
+  std::atomic<std::size_t> manipulators{0};
+
+  ~Impl() {
+    if (participant > 0) dds_delete(participant);
+    if (ownDomain && domain > 0) dds_delete(domain);
+  }
+
+  dds_entity_t topic(const dds_topic_descriptor_t& desc, const std::string& name) {
+    const std::string full = ddsTopicName(nameSpace, name);
+    auto it = topics.find(full);
+    if (it != topics.end()) return it->second;
+    const dds_entity_t t = dds_create_topic(participant, &desc, full.c_str(), nullptr, nullptr);
+    if (t < 0) throw std::runtime_error("Ros2Bridge: cannot create topic " + full + ": " + ddsError(t));
+    topics.emplace(full, t);
+    return t;
+  }
+
+  // ROS 2's default QoS (reliable, volatile, keep-last 10), or transient-local keep-last 1 as
+  // robot_state_publisher offers robot_description; XCDR1 as rmw_cyclonedds writes.
+  dds_entity_t writer(const dds_topic_descriptor_t& desc, const std::string& name, bool transientLocal) {
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+    if (transientLocal) {
+      dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+      dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+    } else {
+      dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+      dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+    }
+    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+    dds_qset_data_representation(qos, 1, &xcdr1);
+    const dds_entity_t w = dds_create_writer(participant, topic(desc, name), qos, nullptr);
+    dds_delete_qos(qos);
+    if (w < 0) throw std::runtime_error("Ros2Bridge: cannot create a writer on " + name + ": " + ddsError(w));
+    return w;
+  }
+
+  void write(dds_entity_t w, const void* sample, std::atomic<std::uint64_t>& counter) {
+    if (dds_write(w, sample) < 0)
+      ++failures;
+    else
+      ++counter;
+  }
+
+  void writeString(dds_entity_t w, const std::string& text, std::atomic<std::uint64_t>& counter) {
+    std_msgs_msg_dds__String_ s{};
+    s.data = const_cast<char*>(text.c_str());
+    write(w, &s, counter);
+  }
+
+  void addArm(const RoboticObject* o, Manipulator& m, ArmEntry& e);
+  void cycle();
+  void publishCombinedDescription();
+};
+
+Ros2Bridge::Ros2Bridge(const std::string& name) : FunctionalObject(ClassSection(name, "Ros2Bridge")), impl_(std::make_unique<Impl>()) {
+  Ros2BridgeOptions& o = impl_->options;
+  const ConfigSection* section = configSection();
+  if (section) {
+    if (const ConfigSetting* s = section->find("domain")) {
+      const double d = section->getNumbers("domain").at(0);
+      if (!(d >= 0 && d <= kMaxDomain) || d != std::floor(d))
+        throw section->errorAt(*s, "setting 'domain' must be a whole number 0 .. " + std::to_string(kMaxDomain));
+      o.domain = static_cast<int>(d);
+    }
+    if (const ConfigSetting* s = section->find("namespace")) {
+      o.nameSpace = section->getWord("namespace");
+      if (!validNamespace(o.nameSpace))
+        throw section->errorAt(*s, "setting 'namespace' must be a ROS namespace such as cell1 or /lab/cell1 (letters, "
+                                   "digits, '_' and '/', each part starting with a letter or '_')");
+    }
+    if (const ConfigSetting* s = section->find("rate")) {
+      const double r = section->getNumbers("rate").at(0);
+      if (!(r >= 1 && r <= 1000)) throw section->errorAt(*s, "setting 'rate' must be 1 .. 1000 Hz");
+      o.rate = r;
+    }
+    if (const ConfigSetting* s = section->find("interfaces")) {
+      if (s->values.empty()) throw section->errorAt(*s, "setting 'interfaces' needs at least one interface");
+      for (const std::string& v : s->values)
+        if (!validInterface(v)) throw section->errorAt(*s, "setting 'interfaces': '" + v + "' is not an interface name or address");
+      o.interfaces = s->values;
+    }
+  }
+  try {
+    start();
+  } catch (const std::exception& e) {
+    if (section) {
+      if (const ConfigSetting* s = section->find("interfaces")) throw section->errorAt(*s, std::string("setting 'interfaces': ") + e.what());
+      throw ConfigError(section->fileName(), section->line(), e.what());
+    }
+    throw;
+  }
+  startControlLoop();
+}
+
+Ros2Bridge::Ros2Bridge(const std::string& name, const Ros2BridgeOptions& options)
+    : FunctionalObject(name), impl_(std::make_unique<Impl>()) {
+  if (const std::string why = checkOptions(options); !why.empty()) throw std::invalid_argument("Ros2Bridge: " + why);
+  impl_->options = options;
+  start();
+  startControlLoop();
+}
+
+Ros2Bridge::~Ros2Bridge() {
+  stopControlLoop();  // first: the publishing thread ends before DDS goes
+  impl_.reset();
+}
+
+std::string Ros2Bridge::checkOptions(const Ros2BridgeOptions& o) {
+  if (o.domain < 0 || o.domain > kMaxDomain) return "domain must be 0 .. " + std::to_string(kMaxDomain);
+  if (!validNamespace(o.nameSpace)) return "namespace '" + o.nameSpace + "' is not a ROS namespace";
+  if (!(o.rate >= 1 && o.rate <= 1000)) return "rate must be 1 .. 1000 Hz";
+  if (o.interfaces.empty()) return "interfaces must name at least one interface";
+  for (const std::string& v : o.interfaces)
+    if (!validInterface(v)) return "'" + v + "' is not an interface name or address";
+  return "";
+}
+
+void Ros2Bridge::declareSettings(SettingSchema& schema) {
+  RoboticObject::declareSettings(schema);
+  schema.addInteger("domain", "DDS domain id (ROS_DOMAIN_ID)", 0, kMaxDomain);
+  schema.addWord("namespace", "ROS namespace of the topics, e.g. cell1");
+  schema.addNumbers("rate", 1, "Hz", "joint_states and tf samples per second", 1, 1000);
+  SettingSpec interfaces;
+  interfaces.name = "interfaces";
+  interfaces.kind = SettingKind::Word;
+  interfaces.minValues = 1;
+  interfaces.maxValues = 16;
+  interfaces.description = "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice";
+  schema.add(interfaces);
+  schema.setDefault("domain", "0");
+  schema.setDefault("namespace", "(none)");
+  schema.setDefault("rate", "50");
+  schema.setDefault("interfaces", "lo");
+}
+
+const Ros2BridgeOptions& Ros2Bridge::getOptions() const noexcept { return impl_->options; }
+
+Ros2BridgeStatistics Ros2Bridge::getStatistics() const noexcept {
+  Ros2BridgeStatistics s;
+  s.cycles = impl_->cycles;
+  s.jointStates = impl_->jointStatesWritten;
+  s.tf = impl_->tfWritten;
+  s.descriptions = impl_->descriptions;
+  s.states = impl_->states;
+  s.writeFailures = impl_->failures;
+  s.manipulators = impl_->manipulators;
+  return s;
+}
+
+std::string Ros2Bridge::ddsTopicName(const std::string& nameSpace, const std::string& topic) {
+  std::string ns = nameSpace;
+  while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);
+  while (!ns.empty() && ns.back() == '/') ns.pop_back();
+  return ns.empty() ? "rt/" + topic : "rt/" + ns + "/" + topic;
+}
+
+std::string Ros2Bridge::cycloneConfig(const std::vector<std::string>& interfaces) {
+  std::ostringstream x;
+  x << "<CycloneDDS><Domain Id=\"any\">";
+  const bool any = interfaces.size() == 1 && interfaces[0] == "any";
+  if (!any) {
+    x << "<General><Interfaces>";
+    for (const std::string& i : interfaces) {
+      const bool address = isIpv4Address(i);
+      x << "<NetworkInterface " << (address ? "address" : "name") << "=\"" << i << "\"/>";
+    }
+    x << "</Interfaces>";
+    const bool loopbackOnly = interfaces.size() == 1 && (interfaces[0] == "lo" || interfaces[0] == "127.0.0.1");
+    // Linux's lo has no multicast: participants on this machine find each other by unicast.
+    if (loopbackOnly) x << "<AllowMulticast>false</AllowMulticast>";
+    x << "</General>";
+    if (loopbackOnly)
+      x << "<Discovery><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex>"
+           "<Peers><Peer Address=\"127.0.0.1\"/></Peers></Discovery>";
+  }
+  x << "</Domain></CycloneDDS>";
+  return x.str();
+}
+
+std::string Ros2Bridge::prefixUrdf(const std::string& object, const std::string& urdf) {
+  static const char* const kNameAttributes[] = {"<link name=\"",         "<joint name=\"",  "<transmission name=\"",
+                                                "<actuator name=\"",     "<parent link=\"", "<child link=\""};
+  const std::string prefix = rosName(object) + "_";
+  std::string out;
+  out.reserve(urdf.size() + urdf.size() / 8);
+  std::size_t at = 0;
+  for (;;) {
+    std::size_t next = std::string::npos, length = 0;  // the earliest name attribute from `at`
+    for (const char* a : kNameAttributes) {
+      const std::size_t p = urdf.find(a, at);
+      if (p < next) {
+        next = p;
+        length = std::strlen(a);
+      }
+    }
+    if (next == std::string::npos) break;
+    const std::size_t nameStart = next + length;
+    const std::size_t nameEnd = urdf.find('"', nameStart);
+    if (nameEnd == std::string::npos) break;
+    out.append(urdf, at, nameStart - at);
+    const std::string name = urdf.substr(nameStart, nameEnd - nameStart);
+    if (name != "world") out += prefix;
+    out += name;
+    at = nameEnd;
+  }
+  out.append(urdf, at, std::string::npos);
+  return out;
+}
+
+void Ros2Bridge::start() {
+  Impl& d = *impl_;
+  std::string ns = d.options.nameSpace;
+  while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);
+  while (!ns.empty() && ns.back() == '/') ns.pop_back();
+  d.nameSpace = ns;
+  const auto domainId = static_cast<dds_domainid_t>(d.options.domain);
+  const std::string config = cycloneConfig(d.options.interfaces);
+  d.domain = dds_create_domain(domainId, config.c_str());
+  if (d.domain >= 0) {
+    d.ownDomain = true;
+  } else if (d.domain != DDS_RETCODE_PRECONDITION_NOT_MET) {  // not: the domain exists in this process already
+    throw std::runtime_error("Ros2Bridge: DDS domain " + std::to_string(d.options.domain) + " cannot start on " +
+                             joined(d.options.interfaces) + ": " +
+                             ddsError(d.domain) + " (see Cyclone DDS's message above)");
+  }
+  d.participant = dds_create_participant(domainId, nullptr, nullptr);
+  if (d.participant < 0)
+    throw std::runtime_error("Ros2Bridge: cannot join DDS domain " + std::to_string(d.options.domain) + ": " +
+                             ddsError(d.participant));
+  d.jointStates = d.writer(sensor_msgs_msg_dds__JointState__desc, "joint_states", false);
+  d.tf = d.writer(tf2_msgs_msg_dds__TFMessage__desc, "tf", false);
+  d.tfStatic = d.writer(tf2_msgs_msg_dds__TFMessage__desc, "tf_static", true);
+  d.description = d.writer(std_msgs_msg_dds__String__desc, "robot_description", true);
+  addPeriodicThread("ros2bridge", 1.0 / d.options.rate, [this] { impl_->cycle(); });
+}
+
+void Ros2Bridge::Impl::addArm(const RoboticObject* o, Manipulator& m, ArmEntry& e) {
+  (void)o;
+  const ManipulatorModel& model = m.getModel();
+  const int n = model.getNumberOfJoints();
+  e.name = m.getName();
+  e.rosName = rosName(e.name);
+  e.data = std::make_unique<ManipulatorData>(model);
+  for (int i = 0; i < n; ++i) {
+    e.jointNames.push_back(e.rosName + "_" + model.getJointName(i));
+    e.frameNames.push_back(e.rosName + "_" + model.getLinkName(i));
+    // URDF link k is the frame after joint k's motion: for standard DH the model's link frame
+    // k without its x translation and twist (see toUrdf()); the model's frame otherwise.
+    Transform q = Transform::unit();
+    if (model.getConvention() == DHConvention::Standard) {
+      const LinkParameters& l = model.getLink(i);
+      q = rigidInverse(translation(l.a, 0, 0) * xRotation(l.alpha));
+    }
+    e.frameFromModel.push_back(q);
+  }
+  e.frameNames.push_back(e.rosName + "_tool");
+  e.frameFromModel.push_back(Transform::unit());
+  e.urdf = prefixUrdf(e.name, toUrdf(model));
+  e.stateWriter = writer(std_msgs_msg_dds__String__desc, e.rosName + "/state", false);
+  e.descriptionWriter = writer(std_msgs_msg_dds__String__desc, e.rosName + "/robot_description", true);
+  writeString(e.descriptionWriter, e.urdf, descriptions);
+  // tf_static: the base, fixed in the world.
+  geometry_msgs_msg_dds__TransformStamped_ ts{};
+  ts.header.stamp = now();
+  ts.header.frame_id = const_cast<char*>("world");
+  const std::string base = e.rosName + "_base_link";
+  ts.child_frame_id = const_cast<char*>(base.c_str());
+  const Transform b = model.getBaseTransform();
+  ts.transform.translation = {b(0, 3), b(1, 3), b(2, 3)};
+  toQuaternion(b, ts.transform.rotation);
+  tf2_msgs_msg_dds__TFMessage_ msg{};
+  msg.transforms._buffer = &ts;
+  msg.transforms._length = msg.transforms._maximum = 1;
+  msg.transforms._release = false;
+  write(tfStatic, &msg, tfWritten);
+}
+
+void Ros2Bridge::Impl::publishCombinedDescription() {
+  // One robot holding every arm: each arm's URDF without its <robot> lines and its world link.
+  std::string all = "<?xml version=\"1.0\"?>\n<robot name=\"" + (nameSpace.empty() ? std::string("rp") : rosName(nameSpace)) +
+                    "\" xmlns:drake=\"http://drake.mit.edu\">\n  <link name=\"world\"/>\n";
+  for (auto& [o, e] : arms) {
+    const std::size_t open = e.urdf.find("<robot");
+    const std::size_t body = e.urdf.find('>', open) + 1;
+    const std::size_t close = e.urdf.rfind("</robot>");
+    std::string part = e.urdf.substr(body, close - body);
+    const std::string world = "<link name=\"world\"/>";
+    if (const std::size_t w = part.find(world); w != std::string::npos) part.erase(w, world.size());
+    all += part;
+  }
+  all += "</robot>\n";
+  writeString(description, all, descriptions);
+}
+
+void Ros2Bridge::Impl::cycle() {
+  ++cycles;
+  std::vector<ObjectReference> published = ObjectManager().getPublishedObjects();
+  for (auto& [o, e] : arms) e.seen = false;
+  bool changed = false;
+  const builtin_interfaces_msg_dds__Time_ stamp = now();
+  std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms;
+  std::vector<std::string> frameIds;  // keeps the child frame names alive
+  std::size_t count = 0;
+  for (const ObjectReference& r : published) {
+    auto* m = dynamic_cast<Manipulator*>(r.get());
+    if (!m) continue;
+    auto it = arms.find(r.get());
+    if (it == arms.end() || it->second.name != m->getName()) {
+      if (it != arms.end()) {  // a new arm at the address of a destroyed one
+        dds_delete(it->second.stateWriter);
+        dds_delete(it->second.descriptionWriter);
+      }
+      ArmEntry e;
+      addArm(r.get(), *m, e);
+      it = arms.insert_or_assign(r.get(), std::move(e)).first;
+      changed = true;
+    }
+    ArmEntry& e = it->second;
+    e.seen = true;
+    ++count;
+    const ManipulatorModel& model = m->getModel();
+    const int n = model.getNumberOfJoints();
+    // One consistent cycle of the servo loop (DefaultManipulator's snapshot: q, qd, tau, power).
+    StateSnapshot snap;
+    JointVector q(n), qd(n), tau(n);
+    bool power = m->isArmPowerOn();
+    if (m->getStateSnapshot(snap) && snap.size >= 3 * n + 1) {
+      for (int i = 0; i < n; ++i) {
+        q(i) = snap.values[i];
+        qd(i) = snap.values[n + i];
+        tau(i) = snap.values[2 * n + i];
+      }
+      power = snap.values[3 * n] != 0;
+    } else {
+      q = m->getJointPosition();
+      qd = m->getJointVelocity();
+      tau = m->getControlOutput();
+    }
+    if (q.size() != n || qd.size() != n || tau.size() != n) continue;
+
+    std::vector<char*> names(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) names[static_cast<std::size_t>(i)] = const_cast<char*>(e.jointNames[static_cast<std::size_t>(i)].c_str());
+    sensor_msgs_msg_dds__JointState_ js{};
+    js.header.stamp = stamp;
+    js.header.frame_id = const_cast<char*>("");
+    js.name._buffer = names.data();
+    js.position._buffer = q.data();
+    js.velocity._buffer = qd.data();
+    js.effort._buffer = tau.data();
+    for (auto* s : {&js.position, &js.velocity, &js.effort}) s->_length = s->_maximum = static_cast<uint32_t>(n);
+    js.name._length = js.name._maximum = static_cast<uint32_t>(n);
+    write(jointStates, &js, jointStatesWritten);
+
+    forwardKinematics(model, *e.data, q);
+    for (std::size_t f = 0; f < e.frameNames.size(); ++f) {
+      const Transform t = (f < static_cast<std::size_t>(n) ? e.data->linkTransforms[f] : e.data->endEffector) * e.frameFromModel[f];
+      geometry_msgs_msg_dds__TransformStamped_ ts{};
+      ts.header.stamp = stamp;
+      ts.header.frame_id = const_cast<char*>("world");
+      ts.child_frame_id = const_cast<char*>(e.frameNames[f].c_str());
+      ts.transform.translation = {t(0, 3), t(1, 3), t(2, 3)};
+      toQuaternion(t, ts.transform.rotation);
+      transforms.push_back(ts);
+    }
+
+    // Diagnostics: when they change and once a second.
+    const ErrorStatus err = m->getErrorStatus();
+    nlohmann::json j = {{"object", e.name},
+                        {"class", m->getClassName()},
+                        {"power", power},
+                        {"errorCode", err.code},
+                        {"error", err.message},
+                        {"shutdown", ObjectManager::isShutdownRequested()},
+                        {"shutdownReason", ObjectManager::isShutdownRequested() ? ObjectManager::getShutdownReason() : ""}};
+    const std::string text = j.dump();
+    const auto t = std::chrono::steady_clock::now();
+    if (text != e.lastState || t - e.lastStateTime >= std::chrono::seconds(1)) {
+      writeString(e.stateWriter, text, states);
+      e.lastState = text;
+      e.lastStateTime = t;
+    }
+  }
+  if (!transforms.empty()) {
+    tf2_msgs_msg_dds__TFMessage_ msg{};
+    msg.transforms._buffer = transforms.data();
+    msg.transforms._length = msg.transforms._maximum = static_cast<uint32_t>(transforms.size());
+    write(tf, &msg, tfWritten);
+  }
+  for (auto it = arms.begin(); it != arms.end();) {  // arms destroyed since: their writers go
+    if (!it->second.seen) {
+      dds_delete(it->second.stateWriter);
+      dds_delete(it->second.descriptionWriter);
+      it = arms.erase(it);
+      changed = true;
+    } else {
+      ++it;
+    }
+  }
+  if (changed) publishCombinedDescription();
+  manipulators = count;
+}
+
+}  // namespace rp
+
+RP_REGISTER_CLASS_AS(rp::Ros2Bridge, "Ros2Bridge");

@@ -1,0 +1,391 @@
+// Ros2Bridge: a simulated Puma 560 published on DDS, read back with plain Cyclone DDS readers
+// generated from the same IDL: topic and type names as ROS 2 has them, joint names, sizes and
+// values against the arm, tf against its kinematics, robot_description for a late joiner, the
+// writers' QoS as discovery announces them, and bad rp.cfg settings.
+#include "rp/ros2/Ros2Bridge.hpp"
+
+#include <dds/dds.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <sstream>
+#include <functional>
+#include <string>
+#include <thread>
+
+#include "rp/RoboticPlatform.hpp"
+#include "sensor_msgs.h"
+#include "std_msgs.h"
+#include "tf2_msgs.h"
+
+namespace rp {
+namespace {
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// A domain and a namespace of this process's own, so that parallel test processes never meet.
+Ros2BridgeOptions uniqueOptions() {
+  Ros2BridgeOptions o;
+  o.domain = 1 + static_cast<int>(getpid() % 200);
+  o.nameSpace = "t" + std::to_string(getpid());
+  o.rate = 100;
+  return o;
+}
+
+class Ros2BridgeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    RoboticPlatform::setSimulationModeOn();
+    ObjectManager::resetShutdown();
+  }
+  void TearDown() override {
+    if (participant_ > 0) dds_delete(participant_);  // before the bridge takes the domain down
+    participant_ = 0;
+    ObjectManager().deleteAllObjects();
+    RoboticPlatform::setConfiguration(Configuration());
+  }
+  void configure(const std::string& text) { RoboticPlatform::setConfiguration(Configuration::parse(text, "test.cfg")); }
+
+  // A reader of ROS topic `topic` in the bridge's namespace (transient-local for a late joiner).
+  dds_entity_t reader(const dds_topic_descriptor_t& desc, const std::string& topic, bool transientLocal = false) {
+    if (participant_ <= 0) participant_ = dds_create_participant(static_cast<dds_domainid_t>(options_.domain), nullptr, nullptr);
+    EXPECT_GT(participant_, 0);
+    const std::string name = "rt/" + options_.nameSpace + "/" + topic;
+    const dds_entity_t t = dds_create_topic(participant_, &desc, name.c_str(), nullptr, nullptr);
+    EXPECT_GT(t, 0) << name;
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_durability(qos, transientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+    const dds_entity_t r = dds_create_reader(participant_, t, qos, nullptr);
+    dds_delete_qos(qos);
+    EXPECT_GT(r, 0) << name;
+    return r;
+  }
+
+  // Takes samples until `accept` returns true for one (the sample is loaned until returned).
+  template <class T>
+  bool takeUntil(dds_entity_t r, const std::function<bool(const T&)>& accept, double seconds = 10) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end) {
+      void* samples[1] = {nullptr};
+      dds_sample_info_t info[1];
+      const dds_return_t n = dds_take(r, samples, info, 1, 1);
+      if (n > 0) {
+        const bool ok = info[0].valid_data && accept(*static_cast<const T*>(samples[0]));
+        dds_return_loan(r, samples, n);
+        if (ok) return true;
+      } else {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    }
+    return false;
+  }
+
+  Ros2BridgeOptions options_ = uniqueOptions();
+  dds_entity_t participant_ = 0;
+};
+
+TEST_F(Ros2BridgeTest, DdsNamesFollowRos2Conventions) {
+  EXPECT_EQ(Ros2Bridge::ddsTopicName("", "joint_states"), "rt/joint_states");
+  EXPECT_EQ(Ros2Bridge::ddsTopicName("/lab/cell1/", "tf"), "rt/lab/cell1/tf");
+  const std::string lo = Ros2Bridge::cycloneConfig({"lo"});
+  EXPECT_TRUE(contains(lo, "<Interfaces><NetworkInterface name=\"lo\"/></Interfaces>")) << lo;
+  EXPECT_TRUE(contains(lo, "<Peer Address=\"127.0.0.1\"/>")) << lo;
+  EXPECT_TRUE(contains(Ros2Bridge::cycloneConfig({"10.0.0.2"}), "<NetworkInterface address=\"10.0.0.2\"/>"));
+  EXPECT_FALSE(contains(Ros2Bridge::cycloneConfig({"any"}), "Interfaces"));
+  const std::string urdf = "<robot name=\"r\">\n  <link name=\"world\"/>\n  <link name=\"link1\"/>\n"
+                           "  <joint name=\"joint1\" type=\"revolute\">\n    <parent link=\"world\"/>\n"
+                           "    <child link=\"link1\"/>\n  </joint>\n</robot>\n";
+  EXPECT_EQ(Ros2Bridge::prefixUrdf("arm", urdf),
+            "<robot name=\"r\">\n  <link name=\"world\"/>\n  <link name=\"arm_link1\"/>\n"
+            "  <joint name=\"arm_joint1\" type=\"revolute\">\n    <parent link=\"world\"/>\n"
+            "    <child link=\"arm_link1\"/>\n  </joint>\n</robot>\n");
+  EXPECT_EQ(Ros2Bridge::checkOptions(Ros2BridgeOptions{}), "");
+  Ros2BridgeOptions bad;
+  bad.domain = 231;
+  EXPECT_TRUE(contains(Ros2Bridge::checkOptions(bad), "domain"));
+  bad = {};
+  bad.nameSpace = "9lives";
+  EXPECT_TRUE(contains(Ros2Bridge::checkOptions(bad), "namespace"));
+  bad = {};
+  bad.rate = 0;
+  EXPECT_TRUE(contains(Ros2Bridge::checkOptions(bad), "rate"));
+  EXPECT_THROW(Ros2Bridge("b", bad), std::invalid_argument);
+}
+
+TEST_F(Ros2BridgeTest, PublishesTheArmsJointStatesWithRos2NamesAndTypes) {
+  Puma560 puma("puma");
+  Ros2Bridge bridge("ros", options_);
+  const dds_entity_t r = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
+  char name[200];
+  ASSERT_GE(dds_get_name(dds_get_topic(r), name, sizeof name), 0);
+  EXPECT_EQ(std::string(name), "rt/" + options_.nameSpace + "/joint_states");
+  ASSERT_GE(dds_get_type_name(dds_get_topic(r), name, sizeof name), 0);
+  EXPECT_EQ(std::string(name), "sensor_msgs::msg::dds_::JointState_");
+
+  const JointVector q = puma.getJointPosition();  // the simulated arm holds where it starts
+  ASSERT_EQ(q.size(), 6);
+  int checked = 0;
+  const bool got = takeUntil<sensor_msgs_msg_dds__JointState_>(r, [&](const sensor_msgs_msg_dds__JointState_& js) {
+    EXPECT_EQ(js.name._length, 6u);
+    EXPECT_EQ(js.position._length, 6u);
+    EXPECT_EQ(js.velocity._length, 6u);
+    EXPECT_EQ(js.effort._length, 6u);
+    if (js.name._length != 6 || js.position._length != 6 || js.velocity._length != 6 || js.effort._length != 6) return true;
+    for (int k = 0; k < 6; ++k) {
+      EXPECT_EQ(std::string(js.name._buffer[k]), "puma_joint" + std::to_string(k + 1));
+      EXPECT_NEAR(js.position._buffer[k], q(k), 1e-3) << k;
+      EXPECT_TRUE(std::isfinite(js.velocity._buffer[k]));
+      EXPECT_TRUE(std::isfinite(js.effort._buffer[k]));
+    }
+    // The stamp is the wall clock, as ROS 2's time is.
+    const double stamp = js.header.stamp.sec + 1e-9 * js.header.stamp.nanosec;
+    const double wall = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+    EXPECT_NEAR(stamp, wall, 5.0);
+    return ++checked >= 3;  // several cycles
+  });
+  EXPECT_TRUE(got) << "no joint_states from the bridge";
+  const Ros2BridgeStatistics s = bridge.getStatistics();
+  EXPECT_EQ(s.manipulators, 1u);
+  EXPECT_GE(s.jointStates, 3u);
+  EXPECT_EQ(s.writeFailures, 0u);
+}
+
+TEST_F(Ros2BridgeTest, WritersAnnounceRos2QosAndXcdr1) {
+  Puma560 puma("puma");
+  Ros2Bridge bridge("ros", options_);
+  if (participant_ <= 0) participant_ = dds_create_participant(static_cast<dds_domainid_t>(options_.domain), nullptr, nullptr);
+  ASSERT_GT(participant_, 0);
+  const dds_entity_t pubs = dds_create_reader(participant_, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+  ASSERT_GT(pubs, 0);
+  const std::string prefix = "rt/" + options_.nameSpace + "/";
+  std::map<std::string, std::string> types;
+  std::map<std::string, bool> transientLocal;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (types.size() < 6 && std::chrono::steady_clock::now() < end) {
+    void* samples[16] = {};
+    dds_sample_info_t info[16];
+    const dds_return_t n = dds_take(pubs, samples, info, 16, 16);
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (!info[i].valid_data) continue;
+      const auto* ep = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
+      const std::string topic = ep->topic_name;
+      if (topic.rfind(prefix, 0) != 0) continue;
+      types[topic.substr(prefix.size())] = ep->type_name;
+      dds_reliability_kind_t rel;
+      dds_duration_t block;
+      ASSERT_TRUE(dds_qget_reliability(ep->qos, &rel, &block));
+      EXPECT_EQ(rel, DDS_RELIABILITY_RELIABLE) << topic;
+      dds_durability_kind_t dur;
+      ASSERT_TRUE(dds_qget_durability(ep->qos, &dur));
+      transientLocal[topic.substr(prefix.size())] = dur == DDS_DURABILITY_TRANSIENT_LOCAL;
+      uint32_t reps = 0;
+      dds_data_representation_id_t* values = nullptr;
+      ASSERT_TRUE(dds_qget_data_representation(ep->qos, &reps, &values));
+      ASSERT_EQ(reps, 1u) << topic;
+      EXPECT_EQ(values[0], DDS_DATA_REPRESENTATION_XCDR1) << topic;
+      dds_free(values);
+    }
+    if (n > 0) dds_return_loan(pubs, samples, n);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(types["joint_states"], "sensor_msgs::msg::dds_::JointState_");
+  EXPECT_EQ(types["tf"], "tf2_msgs::msg::dds_::TFMessage_");
+  EXPECT_EQ(types["tf_static"], "tf2_msgs::msg::dds_::TFMessage_");
+  EXPECT_EQ(types["robot_description"], "std_msgs::msg::dds_::String_");
+  EXPECT_EQ(types["puma/robot_description"], "std_msgs::msg::dds_::String_");
+  EXPECT_EQ(types["puma/state"], "std_msgs::msg::dds_::String_");
+  EXPECT_FALSE(transientLocal["joint_states"]);
+  EXPECT_FALSE(transientLocal["tf"]);
+  EXPECT_FALSE(transientLocal["puma/state"]);
+  EXPECT_TRUE(transientLocal["tf_static"]);
+  EXPECT_TRUE(transientLocal["robot_description"]);
+  EXPECT_TRUE(transientLocal["puma/robot_description"]);
+}
+
+TEST_F(Ros2BridgeTest, ALateJoinerGetsTheRobotDescription) {
+  Puma560 puma("puma");
+  Ros2Bridge bridge("ros", options_);
+  // Late: after the bridge has published the descriptions.
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (bridge.getStatistics().descriptions < 2 && std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_GE(bridge.getStatistics().descriptions, 2u);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+
+  const std::string expected = Ros2Bridge::prefixUrdf("puma", toUrdf(puma.getModel()));
+  EXPECT_TRUE(contains(expected, "<joint name=\"puma_joint6\""));
+  const dds_entity_t arm = reader(std_msgs_msg_dds__String__desc, "puma/robot_description", true);
+  EXPECT_TRUE(takeUntil<std_msgs_msg_dds__String_>(arm, [&](const std_msgs_msg_dds__String_& s) {
+    EXPECT_EQ(std::string(s.data), expected);
+    return true;
+  })) << "no puma/robot_description for a late joiner";
+  const dds_entity_t all = reader(std_msgs_msg_dds__String__desc, "robot_description", true);
+  EXPECT_TRUE(takeUntil<std_msgs_msg_dds__String_>(all, [&](const std_msgs_msg_dds__String_& s) {
+    const std::string text = s.data;
+    EXPECT_TRUE(contains(text, "<joint name=\"puma_joint1\" type=\"revolute\">")) << text;
+    EXPECT_TRUE(contains(text, "<link name=\"puma_tool\"/>")) << text;
+    const std::size_t world = text.find("<link name=\"world\"/>");
+    EXPECT_NE(world, std::string::npos);
+    EXPECT_EQ(text.find("<link name=\"world\"/>", world + 1), std::string::npos) << "one world link";
+    return true;
+  })) << "no robot_description for a late joiner";
+  // tf_static: the base for a late joiner too.
+  const dds_entity_t st = reader(tf2_msgs_msg_dds__TFMessage__desc, "tf_static", true);
+  EXPECT_TRUE(takeUntil<tf2_msgs_msg_dds__TFMessage_>(st, [&](const tf2_msgs_msg_dds__TFMessage_& m) {
+    EXPECT_EQ(m.transforms._length, 1u);
+    if (m.transforms._length != 1) return true;
+    EXPECT_EQ(std::string(m.transforms._buffer[0].header.frame_id), "world");
+    EXPECT_EQ(std::string(m.transforms._buffer[0].child_frame_id), "puma_base_link");
+    const Transform b = puma.getModel().getBaseTransform();
+    EXPECT_NEAR(m.transforms._buffer[0].transform.translation.z, b(2, 3), 1e-12);
+    return true;
+  })) << "no tf_static for a late joiner";
+}
+
+TEST_F(Ros2BridgeTest, TfGivesEveryLinkFrameAndTheEndEffectorInTheWorld) {
+  Puma560 puma("puma");
+  Ros2Bridge bridge("ros", options_);
+  const dds_entity_t r = reader(tf2_msgs_msg_dds__TFMessage__desc, "tf");
+  const Transform ee = puma.getEndEffectorTransform();
+  const ManipulatorModel& model = puma.getModel();
+  ManipulatorData data(model);
+  forwardKinematics(model, data, puma.getJointPosition());
+  EXPECT_TRUE(takeUntil<tf2_msgs_msg_dds__TFMessage_>(r, [&](const tf2_msgs_msg_dds__TFMessage_& m) {
+    EXPECT_EQ(m.transforms._length, 7u);  // link1..6 and the tool
+    if (m.transforms._length != 7) return true;
+    for (uint32_t f = 0; f < 7; ++f) {
+      const auto& ts = m.transforms._buffer[f];
+      EXPECT_EQ(std::string(ts.header.frame_id), "world");
+      const std::string child = ts.child_frame_id;
+      const Eigen::Quaterniond qr(ts.transform.rotation.w, ts.transform.rotation.x, ts.transform.rotation.y,
+                                  ts.transform.rotation.z);
+      EXPECT_NEAR(qr.norm(), 1.0, 1e-9);
+      Transform t = Transform::unit();
+      t.topLeftCorner<3, 3>() = qr.toRotationMatrix();
+      t(0, 3) = ts.transform.translation.x;
+      t(1, 3) = ts.transform.translation.y;
+      t(2, 3) = ts.transform.translation.z;
+      if (f == 6) {
+        EXPECT_EQ(child, "puma_tool");
+        EXPECT_NEAR((t - ee).norm(), 0.0, 1e-4);
+      } else {
+        EXPECT_EQ(child, "puma_link" + std::to_string(f + 1));
+        // URDF link k is the model's DH frame k without its x offset and twist (toUrdf()).
+        const LinkParameters& l = model.getLink(static_cast<int>(f));
+        const Transform dh = t * translation(l.a, 0, 0) * xRotation(l.alpha);
+        EXPECT_NEAR((dh - data.linkTransforms[f]).norm(), 0.0, 1e-4) << child;
+      }
+    }
+    return true;
+  })) << "no tf from the bridge";
+}
+
+TEST_F(Ros2BridgeTest, StateTellsPowerErrorsAndShutdown) {
+  Puma560 puma("puma");
+  Ros2Bridge bridge("ros", options_);
+  const dds_entity_t r = reader(std_msgs_msg_dds__String__desc, "puma/state");
+  EXPECT_TRUE(takeUntil<std_msgs_msg_dds__String_>(r, [&](const std_msgs_msg_dds__String_& s) {
+    const nlohmann::json j = nlohmann::json::parse(s.data);
+    EXPECT_EQ(j["object"], "puma");
+    EXPECT_EQ(j["class"], "Puma560");
+    EXPECT_EQ(j["power"], puma.isArmPowerOn());
+    EXPECT_EQ(j["errorCode"], 0);
+    EXPECT_EQ(j["shutdown"], false);
+    return true;
+  })) << "no state";
+  ObjectManager::requestSystemShutdown("test: stop everything");
+  EXPECT_TRUE(takeUntil<std_msgs_msg_dds__String_>(r, [&](const std_msgs_msg_dds__String_& s) {
+    const nlohmann::json j = nlohmann::json::parse(s.data);
+    return j["shutdown"] == true && contains(j["shutdownReason"].get<std::string>(), "test: stop everything");
+  })) << "no state with the shutdown";
+  ObjectManager::resetShutdown();
+}
+
+// The set-up: the reader in another process, discovery and samples over loopback UDP
+// (unicast: lo has no multicast), robot_description taken as a late joiner.
+TEST_F(Ros2BridgeTest, AReaderInAnotherProcessGetsJointStatesAndTheDescription) {
+  Puma560 puma("puma");
+  Ros2Bridge bridge("ros", options_);
+  const JointVector q = puma.getJointPosition();
+  const std::string command = std::string(RP_ROS2_READER_PATH) + " " + std::to_string(options_.domain) + " " +
+                              options_.nameSpace + " 2>&1";
+  FILE* child = popen(command.c_str(), "r");
+  ASSERT_NE(child, nullptr);
+  std::string out;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, child)) out += buffer;
+  const int status = pclose(child);
+  ASSERT_EQ(status, 0) << out;
+  std::istringstream lines(out);
+  std::string line;
+  bool jointStates = false, description = false;
+  while (std::getline(lines, line)) {
+    std::istringstream words(line);
+    std::string kind;
+    words >> kind;
+    if (kind == "joint_states") {
+      jointStates = true;
+      for (int k = 0; k < 6; ++k) {
+        std::string name;
+        double position = NAN;
+        ASSERT_TRUE(words >> name >> position) << line;
+        EXPECT_EQ(name, "puma_joint" + std::to_string(k + 1));
+        EXPECT_NEAR(position, q(k), 1e-3) << name;
+      }
+      std::string more;
+      EXPECT_FALSE(words >> more) << "more than 6 joints: " << line;
+    } else if (kind == "robot_description") {
+      description = true;
+      std::size_t bytes = 0;
+      words >> bytes;
+      EXPECT_GT(bytes, 1000u);
+      EXPECT_TRUE(contains(line, "<joint name=\"puma_joint6\" type=\"revolute\">")) << line.substr(0, 300);
+    }
+  }
+  EXPECT_TRUE(jointStates) << out;
+  EXPECT_TRUE(description) << out;
+}
+
+TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"domain 231", "domain"},
+      {"domain 2.5", "domain"},
+      {"namespace 9lives", "namespace"},
+      {"namespace a//b", "namespace"},
+      {"rate 0", "rate"},
+      {"rate 5000", "rate"},
+      {"interfaces no$such", "interfaces"},
+      {"interfaces rpnosuchif0", "interfaces"},
+  };
+  for (const auto& [line, setting] : cases) {
+    try {
+      configure(std::string("[ros]\nclass Ros2Bridge\n") + line + "\n");  // the schema's checks
+      ObjectManager().createDerivedObject<Ros2Bridge>("ros");
+      ADD_FAILURE() << line << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_TRUE(contains(e.what(), "test.cfg:3")) << line << ": " << e.what();
+      EXPECT_TRUE(contains(e.what(), setting)) << line << ": " << e.what();
+    }
+    ObjectManager().deleteAllObjects();
+  }
+  // Good settings from rp.cfg are taken.
+  configure("[ros]\nclass Ros2Bridge\ndomain " + std::to_string(options_.domain) + "\nnamespace /" + options_.nameSpace +
+            "/\nrate 20\ninterfaces lo\n");
+  auto* bridge = ObjectManager().createDerivedObject<Ros2Bridge>("ros");
+  ASSERT_NE(bridge, nullptr);
+  EXPECT_EQ(bridge->getOptions().domain, options_.domain);
+  EXPECT_EQ(bridge->getOptions().rate, 20);
+  EXPECT_EQ(bridge->getOptions().interfaces, std::vector<std::string>{"lo"});
+  EXPECT_EQ(bridge->getClassName(), "Ros2Bridge");
+}
+
+}  // namespace
+}  // namespace rp
