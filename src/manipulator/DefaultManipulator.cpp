@@ -19,47 +19,33 @@
 #include "rp/trajectory/TrajectoryGenerator.hpp"
 #include "../model/ChainInternal.hpp"
 #include "LinkShapes.hpp"
-#include "PayloadHandover.hpp"
+#include "SeqlockHandover.hpp"
 
 namespace rp {
 
 // External wrenches (slot 0: the end-effector's; slot k: link k's, with its point) cross from
-// user threads to the servo thread through a sequence lock: writers (serialised by a mutex) never
-// block the reader, which retries a torn read and skips the copy when nothing changed.
+// user threads to the servo thread through a SeqlockHandover: writers (serialised by a mutex)
+// never block the reader, which retries a torn read and skips the copy when nothing changed.
 struct DefaultManipulator::WrenchBox {
   static constexpr int kSlot = 9;  // point (3), then force and moment (6)
-  static constexpr int kSize = kSlot * (kMaxJoints + 1);
+  static constexpr std::size_t kSize = kSlot * (kMaxJoints + 1);
   std::mutex writerMutex;
-  std::atomic<unsigned> sequence{0};
-  std::atomic<double> values[kSize] = {};
-  // Servo thread's: the last consistent copy and the sequence it was read at.
+  internal::SeqlockHandover<kSize> values;
+  // Servo thread's: the last consistent copy and the version it was read at.
   double snapshot[kSize] = {};
-  unsigned lastRead = 0;
+  std::uint64_t lastRead = 0;
 
   void write(int slot, const Vector<3>& point, const Vector<6>& w) {
+    const double v[kSlot] = {point(0), point(1), point(2), w(0), w(1), w(2), w(3), w(4), w(5)};
     std::lock_guard<std::mutex> lock(writerMutex);
-    sequence.fetch_add(1, std::memory_order_acq_rel);
-    std::atomic<double>* v = values + slot * kSlot;
-    for (int i = 0; i < 3; ++i) v[i].store(point(i), std::memory_order_relaxed);
-    for (int i = 0; i < 6; ++i) v[3 + i].store(w(i), std::memory_order_relaxed);
-    sequence.fetch_add(1, std::memory_order_release);
+    values.store(static_cast<std::size_t>(slot * kSlot), v, kSlot);
   }
   // Real-time safe: lock-free. Returns true with a new snapshot (the first `slots` slots) when a
   // write happened since the last read; gives up (keeping the old one) after a few torn reads.
   bool read(int slots) {
-    if (sequence.load(std::memory_order_acquire) == lastRead) return false;
-    for (int attempt = 0; attempt < 8; ++attempt) {
-      const unsigned before = sequence.load(std::memory_order_acquire);
-      if (before & 1u) continue;
-      double copy[kSize];
-      // Acquire loads keep the second read of the sequence after the values.
-      for (int i = 0; i < slots * kSlot; ++i) copy[i] = values[i].load(std::memory_order_acquire);
-      if (sequence.load(std::memory_order_acquire) == before) {
-        std::copy(copy, copy + slots * kSlot, snapshot);
-        lastRead = before;
-        return true;
-      }
-    }
+    if (values.version() == lastRead) return false;
+    for (int attempt = 0; attempt < 8; ++attempt)
+      if (values.tryLoad(snapshot, static_cast<std::size_t>(slots * kSlot), &lastRead)) return true;
     return false;
   }
 };
@@ -96,7 +82,7 @@ int firstNonFinite(const JointVector& v) {
 struct DefaultManipulator::PayloadBox {
   double mass = 0;
   Vector<3> centre = Vector<3>::Zero();
-  internal::PayloadHandover<4> handover;  // mass [kg], centre [m]
+  internal::SeqlockHandover<4> handover;  // mass [kg], centre [m]
 };
 
 struct DefaultManipulator::Setup {

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "PayloadHandover.hpp"
+#include "SeqlockHandover.hpp"
 #include "rp/core/Configuration.hpp"
 
 namespace rp {
@@ -157,7 +157,7 @@ struct ManipulatorSimulation::Payload {
   std::mutex mutex;  // serialises setPayload()
   std::array<Unit, kMaxPayloadCentres> units;
   int count = 0;
-  internal::PayloadHandover<2> handover;  // mass [kg], centre index
+  internal::SeqlockHandover<2> handover;  // mass [kg], centre index
 };
 
 ManipulatorSimulation::ManipulatorSimulation(const ManipulatorModel& model) : model_(model), data_(model) { init(); }
