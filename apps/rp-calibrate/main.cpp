@@ -29,6 +29,7 @@
 
 #include "Calibration.hpp"
 #include "ChooseManipulator.hpp"
+#include "../common/ToolSupport.hpp"
 #include "rp/core/Core.hpp"
 #include "rp/manipulator/Manipulators.hpp"
 #include "rp/trajectory/SynchronizedJointMotion.hpp"
@@ -39,9 +40,7 @@ using namespace rp;
 using namespace rp::calibration;
 using nlohmann::json;
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using tool::UsageError;  // the usage error of every tool (exit status 2)
 
 const char* kUsage =
     "rp-calibrate [switches] [NAME] [--json] [--write FILE] [--offsets on|off] [--poses N] [--seed N]\n"
