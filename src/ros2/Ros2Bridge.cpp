@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../model/ExportFrames.hpp"
 #include "geometry_msgs.h"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/TypeDatabase.hpp"
@@ -381,14 +382,9 @@ void Ros2Bridge::Impl::addArm(const RoboticObject* o, Manipulator& m, ArmEntry& 
   for (int i = 0; i < n; ++i) {
     e.jointNames.push_back(e.rosName + "_" + model.getJointName(i));
     e.frameNames.push_back(e.rosName + "_" + model.getLinkName(i));
-    // URDF link k is the frame after joint k's motion: for standard DH the model's link frame
-    // k without its x translation and twist (see toUrdf()); the model's frame otherwise.
-    Transform q = Transform::unit();
-    if (model.getConvention() == DHConvention::Standard) {
-      const LinkParameters& l = model.getLink(i);
-      q = rigidInverse(translation(l.a, 0, 0) * xRotation(l.alpha));
-    }
-    e.frameFromModel.push_back(q);
+    // URDF link k is the frame after joint k's motion, as toUrdf() writes it: the model's link
+    // frame k without the part of A_k after the motion (jointFrames().post; standard DH only).
+    e.frameFromModel.push_back(rigidInverse(internal::jointFrames(model, i).post));
   }
   e.frameNames.push_back(e.rosName + "_tool");
   e.frameFromModel.push_back(Transform::unit());
