@@ -11,6 +11,7 @@
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -25,6 +26,8 @@
 #include "sensor_msgs.h"
 #include "std_msgs.h"
 #include "tf2_msgs.h"
+#include "trajectory_msgs.h"
+#include "rp/trajectory/TimedTrajectoryGenerator.hpp"
 
 namespace rp {
 
@@ -123,6 +126,10 @@ struct ArmEntry {
   std::string lastState;
   std::chrono::steady_clock::time_point lastStateTime;
   bool seen = false;
+  dds_entity_t trajectoryReader = 0;
+  std::unique_ptr<TimedTrajectoryGenerator> generator;  // connected to the arm on the first trajectory taken
+  std::string lastCommand;  // the message about the last trajectory (accepted or refused)
+  std::uint64_t accepted = 0, refused = 0;
 };
 
 struct Ros2Bridge::Impl {
@@ -136,6 +143,11 @@ struct Ros2Bridge::Impl {
   std::map<const RoboticObject*, ArmEntry> arms;
   std::atomic<std::uint64_t> cycles{0}, jointStatesWritten{0}, tfWritten{0}, descriptions{0}, states{0}, failures{0};
   std::atomic<std::size_t> manipulators{0};
+  std::atomic<std::uint64_t> trajectories{0}, trajectoriesRefused{0};
+  std::atomic<bool> commands{false};
+  std::string bridgeName;
+  mutable std::mutex messagesMutex;
+  std::map<std::string, std::string> lastMessages;  // object name -> lastCommand, for getLastCommandMessage()
 
   ~Impl() {
     if (participant > 0) dds_delete(participant);
@@ -172,6 +184,21 @@ struct Ros2Bridge::Impl {
     return w;
   }
 
+  // A reader with ROS 2's default QoS (reliable, volatile, keep-last 10), XCDR1, as a ROS 2
+  // subscription has it.
+  dds_entity_t reader(const dds_topic_descriptor_t& desc, const std::string& name) {
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+    dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+    dds_qset_data_representation(qos, 1, &xcdr1);
+    const dds_entity_t r = dds_create_reader(participant, topic(desc, name), qos, nullptr);
+    dds_delete_qos(qos);
+    if (r < 0) throw std::runtime_error("Ros2Bridge: cannot create a reader on " + name + ": " + ddsError(r));
+    return r;
+  }
+
   void write(dds_entity_t w, const void* sample, std::atomic<std::uint64_t>& counter) {
     if (dds_write(w, sample) < 0)
       ++failures;
@@ -186,6 +213,8 @@ struct Ros2Bridge::Impl {
   }
 
   void addArm(const RoboticObject* o, Manipulator& m, ArmEntry& e);
+  void takeTrajectories(Manipulator& m, ArmEntry& e);
+  std::string executeTrajectory(Manipulator& m, ArmEntry& e, const trajectory_msgs_msg_dds__JointTrajectory_& msg);
   void cycle();
   void publishCombinedDescription();
 };
@@ -217,6 +246,7 @@ Ros2Bridge::Ros2Bridge(const std::string& name) : FunctionalObject(ClassSection(
         if (!validInterface(v)) throw section->errorAt(*s, "setting 'interfaces': '" + v + "' is not an interface name or address");
       o.interfaces = s->values;
     }
+    if (section->find("commands")) o.commands = section->getWord("commands") == "on";
   }
   try {
     start();
@@ -269,6 +299,8 @@ void Ros2Bridge::declareSettings(SettingSchema& schema) {
   schema.setDefault("namespace", "(none)");
   schema.setDefault("rate", "50");
   schema.setDefault("interfaces", "lo");
+  schema.addChoice("commands", {"on", "off"}, "take trajectories from <object>/joint_trajectory (trajectory_msgs/JointTrajectory)");
+  schema.setDefault("commands", "off");
 }
 
 const Ros2BridgeOptions& Ros2Bridge::getOptions() const noexcept { return impl_->options; }
@@ -282,7 +314,19 @@ Ros2BridgeStatistics Ros2Bridge::getStatistics() const noexcept {
   s.states = impl_->states;
   s.writeFailures = impl_->failures;
   s.manipulators = impl_->manipulators;
+  s.trajectories = impl_->trajectories;
+  s.trajectoriesRefused = impl_->trajectoriesRefused;
   return s;
+}
+
+void Ros2Bridge::setCommandsEnabled(bool on) noexcept { impl_->commands = on; }
+
+bool Ros2Bridge::areCommandsEnabled() const noexcept { return impl_->commands; }
+
+std::string Ros2Bridge::getLastCommandMessage(const std::string& object) const {
+  std::lock_guard<std::mutex> lock(impl_->messagesMutex);
+  const auto it = impl_->lastMessages.find(object);
+  return it == impl_->lastMessages.end() ? std::string() : it->second;
 }
 
 std::string Ros2Bridge::ddsTopicName(const std::string& nameSpace, const std::string& topic) {
@@ -347,6 +391,8 @@ std::string Ros2Bridge::prefixUrdf(const std::string& object, const std::string&
 
 void Ros2Bridge::start() {
   Impl& d = *impl_;
+  d.bridgeName = getName();
+  d.commands = d.options.commands;
   std::string ns = d.options.nameSpace;
   while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);
   while (!ns.empty() && ns.back() == '/') ns.pop_back();
@@ -392,6 +438,8 @@ void Ros2Bridge::Impl::addArm(const RoboticObject* o, Manipulator& m, ArmEntry& 
   e.stateWriter = writer(std_msgs_msg_dds__String__desc, e.rosName + "/state", false);
   e.descriptionWriter = writer(std_msgs_msg_dds__String__desc, e.rosName + "/robot_description", true);
   writeString(e.descriptionWriter, e.urdf, descriptions);
+  e.trajectoryReader = reader(trajectory_msgs_msg_dds__JointTrajectory__desc, e.rosName + "/joint_trajectory");
+  e.generator = std::make_unique<TimedTrajectoryGenerator>(bridgeName + "_" + e.rosName + "_joint_trajectory");
   // tf_static: the base, fixed in the world.
   geometry_msgs_msg_dds__TransformStamped_ ts{};
   ts.header.stamp = now();
@@ -442,6 +490,7 @@ void Ros2Bridge::Impl::cycle() {
       if (it != arms.end()) {  // a new arm at the address of a destroyed one
         dds_delete(it->second.stateWriter);
         dds_delete(it->second.descriptionWriter);
+        dds_delete(it->second.trajectoryReader);
       }
       ArmEntry e;
       addArm(r.get(), *m, e);
@@ -496,6 +545,8 @@ void Ros2Bridge::Impl::cycle() {
       transforms.push_back(ts);
     }
 
+    takeTrajectories(*m, e);
+
     // Diagnostics: when they change and once a second.
     const ErrorStatus err = m->getErrorStatus();
     nlohmann::json j = {{"object", e.name},
@@ -504,7 +555,12 @@ void Ros2Bridge::Impl::cycle() {
                         {"errorCode", err.code},
                         {"error", err.message},
                         {"shutdown", ObjectManager::isShutdownRequested()},
-                        {"shutdownReason", ObjectManager::isShutdownRequested() ? ObjectManager::getShutdownReason() : ""}};
+                        {"shutdownReason", ObjectManager::isShutdownRequested() ? ObjectManager::getShutdownReason() : ""},
+                        {"commands", commands.load()},
+                        {"trajectory", e.lastCommand},
+                        {"trajectoriesAccepted", e.accepted},
+                        {"trajectoriesRefused", e.refused},
+                        {"trajectoryDone", e.generator->isDone()}};
     const std::string text = j.dump();
     const auto t = std::chrono::steady_clock::now();
     if (text != e.lastState || t - e.lastStateTime >= std::chrono::seconds(1)) {
@@ -523,6 +579,7 @@ void Ros2Bridge::Impl::cycle() {
     if (!it->second.seen) {
       dds_delete(it->second.stateWriter);
       dds_delete(it->second.descriptionWriter);
+      dds_delete(it->second.trajectoryReader);
       it = arms.erase(it);
       changed = true;
     } else {
@@ -531,6 +588,183 @@ void Ros2Bridge::Impl::cycle() {
   }
   if (changed) publishCombinedDescription();
   manipulators = count;
+}
+
+// At most this many trajectories are taken per arm and bridge cycle (the rest wait in the reader's
+// keep-last 10 history for the next cycle).
+constexpr int kTrajectoriesPerCycle = 4;
+
+void Ros2Bridge::Impl::takeTrajectories(Manipulator& m, ArmEntry& e) {
+  for (int taken = 0; taken < kTrajectoriesPerCycle; ++taken) {
+    void* samples[1] = {nullptr};
+    dds_sample_info_t info[1];
+    const dds_return_t n = dds_take(e.trajectoryReader, samples, info, 1, 1);
+    if (n <= 0) return;
+    if (info[0].valid_data) {
+      std::string why;
+      try {
+        why = executeTrajectory(m, e, *static_cast<const trajectory_msgs_msg_dds__JointTrajectory_*>(samples[0]));
+      } catch (const std::exception& x) {
+        why = x.what();
+      }
+      if (why.empty()) {
+        ++e.accepted;
+        ++trajectories;
+      } else {
+        e.lastCommand = "refused: " + why;
+        ++e.refused;
+        ++trajectoriesRefused;
+      }
+      std::lock_guard<std::mutex> lock(messagesMutex);
+      lastMessages[e.name] = e.lastCommand;
+    }
+    dds_return_loan(e.trajectoryReader, samples, n);
+  }
+}
+
+namespace {
+
+std::string number(double x) {
+  std::ostringstream o;
+  o << x;
+  return o.str();
+}
+
+std::string field(std::size_t point, const char* name) { return "points[" + std::to_string(point) + "]." + name; }
+
+}  // namespace
+
+// Checks a trajectory_msgs/JointTrajectory for arm `m` and hands it to the arm's generator: ""
+// when it is executed, else why not (the field named as in the message).
+std::string Ros2Bridge::Impl::executeTrajectory(Manipulator& m, ArmEntry& e,
+                                                const trajectory_msgs_msg_dds__JointTrajectory_& msg) {
+  if (!commands) return "commands are off (rp.cfg: commands on in the bridge's section, or setCommandsEnabled(true))";
+  const ManipulatorModel& model = m.getModel();
+  const int n = model.getNumberOfJoints();
+  const auto dof = static_cast<std::size_t>(n);
+  // joint_names: the arm's, each once, in any order.
+  if (msg.joint_names._length != dof)
+    return "joint_names: " + std::to_string(msg.joint_names._length) + " names, the arm has " + std::to_string(n) +
+           " joints (" + joined(e.jointNames) + ")";
+  std::vector<int> jointOf(dof, -1);  // message column -> arm joint
+  std::vector<bool> named(dof, false);
+  for (std::size_t c = 0; c < dof; ++c) {
+    const char* name = msg.joint_names._buffer[c];
+    const std::string text = name != nullptr ? name : "";
+    std::size_t j = 0;
+    while (j < dof && e.jointNames[j] != text) ++j;
+    if (j == dof) return "joint_names[" + std::to_string(c) + "]: '" + text + "' is not a joint of the arm (" + joined(e.jointNames) + ")";
+    if (named[j]) return "joint_names[" + std::to_string(c) + "]: '" + text + "' appears twice";
+    named[j] = true;
+    jointOf[c] = static_cast<int>(j);
+  }
+  // points: how many, sizes, finite values, times.
+  const std::size_t count = msg.points._length;
+  if (count == 0) return "points: none (an empty trajectory does not stop the arm here; send the position to hold)";
+  if (count > static_cast<std::size_t>(TimedJointTrajectory::kMaxPoints))
+    return "points: " + std::to_string(count) + ", more than " + std::to_string(TimedJointTrajectory::kMaxPoints);
+  const auto& p0 = msg.points._buffer[0];
+  const bool velocities = p0.velocities._length != 0, accelerations = p0.accelerations._length != 0;
+  const JointVector qmin = model.getPositionMin(), qmax = model.getPositionMax();
+  std::vector<TimedJointPoint> points(count);
+  double previous = -1;
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto& p = msg.points._buffer[k];
+    if (p.positions._length != dof)
+      return field(k, "positions") + ": " + std::to_string(p.positions._length) + " values, not " + std::to_string(n);
+    if (p.velocities._length != (velocities ? dof : 0))
+      return field(k, "velocities") + ": " + std::to_string(p.velocities._length) + " values, not " +
+             std::to_string(velocities ? n : 0) + " as points[0] (every point needs the same fields)";
+    if (p.accelerations._length != (accelerations ? dof : 0))
+      return field(k, "accelerations") + ": " + std::to_string(p.accelerations._length) + " values, not " +
+             std::to_string(accelerations ? n : 0) + " as points[0] (every point needs the same fields)";
+    if (accelerations && !velocities) return field(k, "accelerations") + ": given without velocities";
+    if (p.time_from_start.nanosec >= 1000000000u) return field(k, "time_from_start.nanosec") + ": 1e9 or more";
+    const double t = p.time_from_start.sec + 1e-9 * p.time_from_start.nanosec;
+    if (t < 0) return field(k, "time_from_start") + ": negative (" + number(t) + " s)";
+    if (!(t > previous))
+      return field(k, "time_from_start") + ": " + number(t) + " s, not after points[" + std::to_string(k - 1) + "] (" +
+             number(previous) + " s)";
+    previous = t;
+    TimedJointPoint& out = points[k];
+    out.time = t;
+    out.position.resize(n);
+    if (velocities) out.velocity.resize(n);
+    if (accelerations) out.acceleration.resize(n);
+    for (std::size_t c = 0; c < dof; ++c) {
+      const int j = jointOf[c];
+      const std::string column = "[" + std::to_string(c) + "] (" + e.jointNames[static_cast<std::size_t>(j)] + ")";
+      const double q = p.positions._buffer[c];
+      if (!std::isfinite(q)) return field(k, "positions") + column + ": not a finite number";
+      if (q < qmin(j) || q > qmax(j))
+        return field(k, "positions") + column + " = " + number(q) + " is outside the joint limits [" + number(qmin(j)) +
+               ", " + number(qmax(j)) + "]";
+      out.position(j) = q;
+      if (velocities) {
+        if (!std::isfinite(p.velocities._buffer[c])) return field(k, "velocities") + column + ": not a finite number";
+        out.velocity(j) = p.velocities._buffer[c];
+      }
+      if (accelerations) {
+        if (!std::isfinite(p.accelerations._buffer[c])) return field(k, "accelerations") + column + ": not a finite number";
+        out.acceleration(j) = p.accelerations._buffer[c];
+      }
+    }
+    if (k + 1 == count && ((velocities && !out.velocity.isZero(0)) || (accelerations && !out.acceleration.isZero(0))))
+      return field(k, "velocities") + ": the last point's velocities and accelerations must be 0 (the arm stops there)";
+  }
+  // header.stamp: 0 starts on receipt (as joint_trajectory_controller); a time in the future later.
+  double delay = 0;
+  if (msg.header.stamp.sec != 0 || msg.header.stamp.nanosec != 0) {
+    const double stamp = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec;
+    const double wall = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+    delay = std::max(0.0, stamp - wall);
+    if (delay > 60) return "header.stamp: " + number(delay) + " s in the future (at most 60 s)";
+  }
+  // The arm: powered, not shutting down, not driven by a program's generator.
+  if (ObjectManager::isShutdownRequested()) return "the system is shutting down";
+  if (!m.isArmPowerOn()) return "the arm power is off";
+  TrajectoryGenerator* driving = m.getTrajectoryGenerator();
+  if (driving != nullptr && driving != e.generator.get())
+    return "the arm follows the program's trajectory generator '" + driving->getName() + "'";
+  // Where the motion starts: the generator's last setpoint if it drives the arm, else the arm at rest.
+  Setpoint start;
+  start.position = m.getJointPosition();
+  start.velocity = JointVector::Zero(n);
+  start.acceleration = JointVector::Zero(n);
+  if (driving != nullptr) {
+    JointVector q, qd;
+    for (int attempt = 0; attempt < 100 && !e.generator->getLastSetpoint(q, qd); ++attempt) std::this_thread::yield();
+    if (q.size() == n) {
+      start.position = q;
+      start.velocity = qd;
+    }
+  }
+  if (points[0].time == 0) {
+    for (int j = 0; j < n; ++j)
+      if (std::abs(points[0].position(j) - start.position(j)) > 1e-3)
+        return field(0, "positions") + " at time_from_start 0: " + e.jointNames[static_cast<std::size_t>(j)] + " is " +
+               number(points[0].position(j) - start.position(j)) + " from the arm's setpoint (a jump; 1e-3 allowed)";
+  }
+  auto trajectory = std::make_unique<TimedJointTrajectory>(std::move(points));
+  trajectory->start(start);
+  const TrajectoryLimitViolation v =
+      trajectory->findLimitViolation(qmin, qmax, model.getVelocityLimit());
+  if (v.found) {
+    const std::string piece = v.point == 0 ? "on the way from the arm's setpoint to points[0]"
+                                           : "between points[" + std::to_string(v.point - 1) + "] and points[" +
+                                                 std::to_string(v.point) + "]";
+    const std::string joint = e.jointNames[static_cast<std::size_t>(v.joint)];
+    return "points[" + std::to_string(v.point) + "]: " + joint + (v.velocity ? " velocity " : " position ") + number(v.value) +
+           (v.velocity ? " exceeds the velocity limit " : " passes the joint limit ") + number(v.limit) + " " + piece +
+           " (at " + number(v.time) + " s)";
+  }
+  if (driving == nullptr) m.setTrajectoryGenerator(*e.generator);
+  const std::size_t size = msg.points._length;
+  const std::string kind = accelerations ? "quintic" : velocities ? "cubic" : "cubic, velocities estimated";
+  e.generator->execute(std::move(trajectory), delay);
+  e.lastCommand = "accepted: " + std::to_string(size) + " points over " + number(previous) + " s (" + kind + ")" +
+                  (delay > 0 ? ", starting in " + number(delay) + " s" : "");
+  return "";
 }
 
 }  // namespace rp

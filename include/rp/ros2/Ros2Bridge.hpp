@@ -23,6 +23,9 @@ struct Ros2BridgeOptions {
   /// Network interfaces DDS may use (Linux names such as `eth0`, or IPv4 addresses); `{"lo"}`
   /// (the default) keeps DDS on this machine; `{"any"}` lets Cyclone DDS choose.
   std::vector<std::string> interfaces{"lo"};
+  /// Whether the arms take trajectories from `<object>/joint_trajectory` (default false: every
+  /// trajectory is refused with a message on `<object>/state`); see Ros2Bridge::setCommandsEnabled().
+  bool commands = false;
 };
 
 /// Counters of a running bridge (samples written since it started), for tests and diagnostics.
@@ -34,6 +37,8 @@ struct Ros2BridgeStatistics {
   std::uint64_t states = 0;         ///< std_msgs/String samples written on the `<object>/state` topics
   std::uint64_t writeFailures = 0;  ///< dds_write calls that failed
   std::size_t manipulators = 0;     ///< manipulators published in the last cycle
+  std::uint64_t trajectories = 0;        ///< trajectory_msgs/JointTrajectory samples accepted (handed to an arm)
+  std::uint64_t trajectoriesRefused = 0; ///< trajectory_msgs/JointTrajectory samples refused
 };
 
 /// Publishes every manipulator of the process on DDS as ROS 2 does (rmw_cyclonedds conventions:
@@ -47,7 +52,14 @@ struct Ros2BridgeStatistics {
 /// | `tf_static` | tf2_msgs/msg/TFMessage | world to each arm's `<object>_base_link` (transient-local) |
 /// | `robot_description` | std_msgs/msg/String | one URDF holding every arm (transient-local) |
 /// | `<object>/robot_description` | std_msgs/msg/String | the arm's URDF (transient-local) |
-/// | `<object>/state` | std_msgs/msg/String | JSON: arm power, error, system shutdown; when it changes and once a second |
+/// | `<object>/state` | std_msgs/msg/String | JSON: arm power, error, system shutdown, the last trajectory accepted or refused; when it changes and once a second |
+///
+/// It subscribes, per arm, to `<object>/joint_trajectory` (trajectory_msgs/msg/JointTrajectory,
+/// the topic of ros2_control's joint_trajectory_controller), only obeyed when commands are on
+/// (`commands on`, setCommandsEnabled()). A trajectory is checked in the bridge's thread (joint
+/// names, sizes, finite values, times, joint position and velocity limits) and executed by a
+/// TimedTrajectoryGenerator the bridge connects to the arm, replacing the motion under way
+/// continuously; a refused one leaves the arm as it was and names the field on `<object>/state`.
 ///
 /// The bridge's own thread samples the arms `rate` times a second from the snapshots their servo
 /// threads publish (as the Scene Viewer does): a servo loop never waits for the bridge or the
@@ -60,6 +72,7 @@ struct Ros2BridgeStatistics {
 /// | `namespace NS` | ROS namespace of the topics (default none) |
 /// | `rate HZ` | joint_states and tf rate 1..1000 Hz (default 50) |
 /// | `interfaces IF...` | network interfaces for DDS (default `lo`: this machine only; `any`: Cyclone's choice) |
+/// | `commands on\|off` | take trajectories from `<object>/joint_trajectory` (default off) |
 class Ros2Bridge : public FunctionalObject {
  public:
   /// Creates the bridge from its rp.cfg section (defaults without one) and starts publishing.
@@ -78,7 +91,7 @@ class Ros2Bridge : public FunctionalObject {
   /// Stops publishing and leaves the DDS domain. Real-time safe: no.
   ~Ros2Bridge() override;
 
-  /// Declares `domain`, `namespace`, `rate` and `interfaces`.
+  /// Declares `domain`, `namespace`, `rate`, `interfaces` and `commands`.
   /// @param[out] schema  schema to add to
   static void declareSettings(SettingSchema& schema);
 
@@ -86,6 +99,16 @@ class Ros2Bridge : public FunctionalObject {
   const Ros2BridgeOptions& getOptions() const noexcept;
   /// Counters since the bridge started. Real-time safe: yes.
   Ros2BridgeStatistics getStatistics() const noexcept;
+  /// Lets the arms take trajectories from `<object>/joint_trajectory` (on), or refuses them (off,
+  /// the default). Switching off does not stop a trajectory under way. Real-time safe: yes.
+  /// @param[in] on  whether to take them
+  void setCommandsEnabled(bool on) noexcept;
+  /// Whether the arms take trajectories from the network. Real-time safe: yes.
+  bool areCommandsEnabled() const noexcept;
+  /// The bridge's message about the last trajectory for arm `object` (accepted or refused, as on
+  /// `<object>/state`), "" if none came. Real-time safe: no.
+  /// @param[in] object  the arm's object name
+  std::string getLastCommandMessage(const std::string& object) const;
 
   /// The DDS topic name of ROS topic `topic` in namespace `nameSpace`: `rt/NS/TOPIC`.
   /// @param[in] nameSpace  ROS namespace (leading and trailing `/` ignored; empty: none)
