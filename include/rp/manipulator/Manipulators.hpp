@@ -17,4 +17,6 @@
 #include "rp/trajectory/QueueTrajectoryGenerator.hpp"
 #include "rp/trajectory/SynchronizedJointMotion.hpp"
 #include "rp/trajectory/Synchronization.hpp"
+#include "rp/trajectory/TimedJointTrajectory.hpp"
+#include "rp/trajectory/TimedTrajectoryGenerator.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
