@@ -19,6 +19,7 @@
 #include <string>
 #include <thread>
 
+#include "Ros2Fixture.hpp"
 #include "rp/RoboticPlatform.hpp"
 #include "sensor_msgs.h"
 #include "std_msgs.h"
@@ -27,70 +28,8 @@
 namespace rp {
 namespace {
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
-
-// A domain and a namespace of this process's own, so that parallel test processes never meet.
-Ros2BridgeOptions uniqueOptions() {
-  Ros2BridgeOptions o;
-  o.domain = 1 + static_cast<int>(getpid() % 200);
-  o.nameSpace = "t" + std::to_string(getpid());
-  o.rate = 100;
-  return o;
-}
-
-class Ros2BridgeTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    RoboticPlatform::setSimulationModeOn();
-    ObjectManager::resetShutdown();
-  }
-  void TearDown() override {
-    if (participant_ > 0) dds_delete(participant_);  // before the bridge takes the domain down
-    participant_ = 0;
-    ObjectManager().deleteAllObjects();
-    RoboticPlatform::setConfiguration(Configuration());
-  }
-  void configure(const std::string& text) { RoboticPlatform::setConfiguration(Configuration::parse(text, "test.cfg")); }
-
-  // A reader of ROS topic `topic` in the bridge's namespace (transient-local for a late joiner).
-  dds_entity_t reader(const dds_topic_descriptor_t& desc, const std::string& topic, bool transientLocal = false) {
-    if (participant_ <= 0) participant_ = dds_create_participant(static_cast<dds_domainid_t>(options_.domain), nullptr, nullptr);
-    EXPECT_GT(participant_, 0);
-    const std::string name = "rt/" + options_.nameSpace + "/" + topic;
-    const dds_entity_t t = dds_create_topic(participant_, &desc, name.c_str(), nullptr, nullptr);
-    EXPECT_GT(t, 0) << name;
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-    dds_qset_durability(qos, transientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
-    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
-    const dds_entity_t r = dds_create_reader(participant_, t, qos, nullptr);
-    dds_delete_qos(qos);
-    EXPECT_GT(r, 0) << name;
-    return r;
-  }
-
-  // Takes samples until `accept` returns true for one (the sample is loaned until returned).
-  template <class T>
-  bool takeUntil(dds_entity_t r, const std::function<bool(const T&)>& accept, double seconds = 10) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (std::chrono::steady_clock::now() < end) {
-      void* samples[1] = {nullptr};
-      dds_sample_info_t info[1];
-      const dds_return_t n = dds_take(r, samples, info, 1, 1);
-      if (n > 0) {
-        const bool ok = info[0].valid_data && accept(*static_cast<const T*>(samples[0]));
-        dds_return_loan(r, samples, n);
-        if (ok) return true;
-      } else {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      }
-    }
-    return false;
-  }
-
-  Ros2BridgeOptions options_ = uniqueOptions();
-  dds_entity_t participant_ = 0;
-};
+using test::contains;
+using Ros2BridgeTest = test::Ros2Fixture;
 
 TEST_F(Ros2BridgeTest, DdsNamesFollowRos2Conventions) {
   EXPECT_EQ(Ros2Bridge::ddsTopicName("", "joint_states"), "rt/joint_states");
@@ -364,6 +303,7 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
       {"rate 5000", "rate"},
       {"interfaces no$such", "interfaces"},
       {"interfaces rpnosuchif0", "interfaces"},
+      {"commands maybe", "commands"},
   };
   for (const auto& [line, setting] : cases) {
     try {
@@ -378,13 +318,18 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
   }
   // Good settings from rp.cfg are taken.
   configure("[ros]\nclass Ros2Bridge\ndomain " + std::to_string(options_.domain) + "\nnamespace /" + options_.nameSpace +
-            "/\nrate 20\ninterfaces lo\n");
+            "/\nrate 20\ninterfaces lo\ncommands on\n");
   auto* bridge = ObjectManager().createDerivedObject<Ros2Bridge>("ros");
   ASSERT_NE(bridge, nullptr);
   EXPECT_EQ(bridge->getOptions().domain, options_.domain);
   EXPECT_EQ(bridge->getOptions().rate, 20);
   EXPECT_EQ(bridge->getOptions().interfaces, std::vector<std::string>{"lo"});
   EXPECT_EQ(bridge->getClassName(), "Ros2Bridge");
+  EXPECT_TRUE(bridge->getOptions().commands);
+  EXPECT_TRUE(bridge->areCommandsEnabled());
+  bridge->setCommandsEnabled(false);
+  EXPECT_FALSE(bridge->areCommandsEnabled());
+  EXPECT_FALSE(Ros2BridgeOptions{}.commands) << "commands are off by default";
 }
 
 }  // namespace
