@@ -270,7 +270,8 @@ TEST_F(Ros2TrajectoryTest, ARefusalKeepsTheMotionAndANewTrajectoryReplacesIt) {
   const dds_entity_t state = reader(std_msgs_msg_dds__String__desc, "puma/state");
   const dds_entity_t w = writer();
   const JointVector q0 = puma.getJointPosition();
-  TrajectoryMessage a = goodTrajectory(q0, pumaDelta(), 3.0);
+  // A: slow (30 s), so that B surely replaces it in mid-motion; the test would wait for it else.
+  TrajectoryMessage a = goodTrajectory(q0, pumaDelta(), 30.0);
   ASSERT_GE(dds_write(w, &a.message()), 0);
   ASSERT_TRUE(waitFor([&] { return bridge.getStatistics().trajectories == 1; }, 20));
   auto* generator = dynamic_cast<TimedTrajectoryGenerator*>(puma.getTrajectoryGenerator());
@@ -287,8 +288,8 @@ TEST_F(Ros2TrajectoryTest, ARefusalKeepsTheMotionAndANewTrajectoryReplacesIt) {
   TrajectoryMessage b = goodTrajectory(q0, -0.5 * pumaDelta(), 1.5);
   b.points.erase(b.points.begin(), b.points.begin() + 2);  // one point: the target
   ASSERT_GE(dds_write(w, &b.message()), 0);
-  ASSERT_TRUE(waitFor([&] { return generator->getStartedCount() == 2; }, 20));
-  ASSERT_TRUE(waitFor([&] { return generator->isDone(); }, 20));
+  ASSERT_TRUE(waitFor([&] { return generator->getStartedCount() == 2; }, 20)) << "B did not replace A";
+  ASSERT_TRUE(waitFor([&] { return generator->isDone(); }, 20)) << "B did not end before A would have";
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const JointVector q = puma.getJointPosition();
   for (int k = 0; k < 6; ++k) EXPECT_NEAR(q(k), target(k), 0.01) << "joint " << k + 1;
