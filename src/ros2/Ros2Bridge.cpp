@@ -299,7 +299,7 @@ void Ros2Bridge::declareSettings(SettingSchema& schema) {
   schema.setDefault("namespace", "(none)");
   schema.setDefault("rate", "50");
   schema.setDefault("interfaces", "lo");
-  schema.addChoice("commands", {"on", "off"}, "take trajectories from <object>/joint_trajectory (trajectory_msgs/JointTrajectory)");
+  schema.addChoice("commands", {"on", "off"}, "take trajectories from each arm's joint_trajectory topic (trajectory_msgs/JointTrajectory)");
   schema.setDefault("commands", "off");
 }
 
