@@ -165,39 +165,27 @@ struct Ros2Bridge::Impl {
   }
 
   // ROS 2's default QoS (reliable, volatile, keep-last 10), or transient-local keep-last 1 as
-  // robot_state_publisher offers robot_description; XCDR1 as rmw_cyclonedds writes.
+  // robot_state_publisher offers robot_description; XCDR1 as rmw_cyclonedds writes and reads.
+  // A writer, or a reader as a ROS 2 subscription has it (`isReader`).
+  dds_entity_t endpoint(const dds_topic_descriptor_t& desc, const std::string& name, bool transientLocal, bool isReader) {
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+    dds_qset_durability(qos, transientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, transientLocal ? 1 : 10);
+    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+    dds_qset_data_representation(qos, 1, &xcdr1);
+    const dds_entity_t t = topic(desc, name);
+    const dds_entity_t e = isReader ? dds_create_reader(participant, t, qos, nullptr) : dds_create_writer(participant, t, qos, nullptr);
+    dds_delete_qos(qos);
+    if (e < 0)
+      throw std::runtime_error(std::string("Ros2Bridge: cannot create a ") + (isReader ? "reader" : "writer") + " on " + name +
+                               ": " + ddsError(e));
+    return e;
+  }
   dds_entity_t writer(const dds_topic_descriptor_t& desc, const std::string& name, bool transientLocal) {
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-    if (transientLocal) {
-      dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
-      dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-    } else {
-      dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
-      dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
-    }
-    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
-    dds_qset_data_representation(qos, 1, &xcdr1);
-    const dds_entity_t w = dds_create_writer(participant, topic(desc, name), qos, nullptr);
-    dds_delete_qos(qos);
-    if (w < 0) throw std::runtime_error("Ros2Bridge: cannot create a writer on " + name + ": " + ddsError(w));
-    return w;
+    return endpoint(desc, name, transientLocal, false);
   }
-
-  // A reader with ROS 2's default QoS (reliable, volatile, keep-last 10), XCDR1, as a ROS 2
-  // subscription has it.
-  dds_entity_t reader(const dds_topic_descriptor_t& desc, const std::string& name) {
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-    dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
-    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
-    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
-    dds_qset_data_representation(qos, 1, &xcdr1);
-    const dds_entity_t r = dds_create_reader(participant, topic(desc, name), qos, nullptr);
-    dds_delete_qos(qos);
-    if (r < 0) throw std::runtime_error("Ros2Bridge: cannot create a reader on " + name + ": " + ddsError(r));
-    return r;
-  }
+  dds_entity_t reader(const dds_topic_descriptor_t& desc, const std::string& name) { return endpoint(desc, name, false, true); }
 
   void write(dds_entity_t w, const void* sample, std::atomic<std::uint64_t>& counter) {
     if (dds_write(w, sample) < 0)

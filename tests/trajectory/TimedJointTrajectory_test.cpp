@@ -85,6 +85,19 @@ Reference quinticReference(double T) {
   return ref;
 }
 
+// The trajectory equals the reference (both joints) every millisecond from 0 to its end.
+void expectReproduces(const TimedJointTrajectory& traj, const Reference& r) {
+  Setpoint s;
+  for (double t = 0; t <= traj.getDuration(); t += 0.001) {
+    traj.evaluate(t, s);
+    for (int i = 0; i < 2; ++i) {
+      ASSERT_NEAR(s.position(i), r.p(i, t), 1e-12) << t;
+      ASSERT_NEAR(s.velocity(i), r.v(i, t), 1e-11) << t;
+      ASSERT_NEAR(s.acceleration(i), r.a(i, t), 1e-10) << t;
+    }
+  }
+}
+
 TEST(TimedJointTrajectory, CubicHermiteReproducesACubicFromItsPointsAndVelocities) {
   const double T = 2.0;
   const Reference r = cubicReference(T);
@@ -96,15 +109,8 @@ TEST(TimedJointTrajectory, CubicHermiteReproducesACubicFromItsPointsAndVelocitie
   EXPECT_EQ(traj.getDuration(), T);
   // Started from the reference's own state at 0, the first piece is the reference too.
   traj.start(state(vec({r.p(0, 0), r.p(1, 0)}), vec({r.v(0, 0), r.v(1, 0)}), vec({0, 0})));
+  expectReproduces(traj, r);
   Setpoint s;
-  for (double t = 0; t <= T; t += 0.001) {
-    traj.evaluate(t, s);
-    for (int i = 0; i < 2; ++i) {
-      ASSERT_NEAR(s.position(i), r.p(i, t), 1e-12) << t;
-      ASSERT_NEAR(s.velocity(i), r.v(i, t), 1e-11) << t;
-      ASSERT_NEAR(s.acceleration(i), r.a(i, t), 1e-10) << t;
-    }
-  }
   traj.evaluate(T + 1, s);  // after the end: the last point, at rest
   EXPECT_NEAR(s.position(0), r.p(0, T), 1e-15);
   EXPECT_EQ(s.velocity.norm(), 0);
@@ -119,15 +125,7 @@ TEST(TimedJointTrajectory, QuinticHermiteReproducesAQuinticFromItsPointsVelociti
   TimedJointTrajectory traj(points);
   EXPECT_EQ(traj.getInterpolation(), TimedJointTrajectory::Interpolation::QuinticHermite);
   traj.start(state(vec({r.p(0, 0), r.p(1, 0)}), vec({r.v(0, 0), r.v(1, 0)}), vec({r.a(0, 0), r.a(1, 0)})));
-  Setpoint s;
-  for (double t = 0; t <= T; t += 0.001) {
-    traj.evaluate(t, s);
-    for (int i = 0; i < 2; ++i) {
-      ASSERT_NEAR(s.position(i), r.p(i, t), 1e-12) << t;
-      ASSERT_NEAR(s.velocity(i), r.v(i, t), 1e-11) << t;
-      ASSERT_NEAR(s.acceleration(i), r.a(i, t), 1e-10) << t;
-    }
-  }
+  expectReproduces(traj, r);
 }
 
 // Finite differences: the velocity is the derivative of the position, the acceleration of the
