@@ -96,9 +96,11 @@ class TimedJointTrajectory {
   /// The first place where the trajectory, started with start(), leaves the position limits
   /// [`min`, `max`] or the velocity limits (|v| <= `vmax`): each piece is checked at its ends and
   /// at `samples` instants between.
-  /// @param[in] min, max  joint position limits (n x 1)
-  /// @param[in] vmax      joint velocity limits (n x 1), > 0
-  /// @param[in] samples   instants checked inside each piece
+  /// @param[in] min      joint position lower limits (n x 1)
+  /// @param[in] max      joint position upper limits (n x 1)
+  /// @param[in] vmax     joint velocity limits (n x 1), > 0
+  /// @param[in] samples  instants checked inside each piece
+  /// @return the first violation in time (`found` false if none)
   /// Real-time safe: no (a trajectory of many points takes a while).
   TrajectoryLimitViolation findLimitViolation(const JointVector& min, const JointVector& max, const JointVector& vmax,
                                               int samples = 32) const;
