@@ -221,25 +221,25 @@ TEST(TimedJointTrajectory, BadPointsAreRefusedNamingThePointAndField) {
   EXPECT_EQ(refusal([&] { TimedJointTrajectory t(many); }), "");
 }
 
+// The first limit violation of `points` started at rest at 0, against [-1, 1] rad and 2 rad/s.
+TrajectoryLimitViolation violation(const std::vector<TimedJointPoint>& points) {
+  TimedJointTrajectory traj(points);
+  traj.start(state(vec({0, 0}), vec({0, 0}), vec({0, 0})));
+  return traj.findLimitViolation(vec({-1, -1}), vec({1, 1}), vec({2, 2}));
+}
+
 TEST(TimedJointTrajectory, LimitViolationsAreFoundWithTheirPointAndJoint) {
-  const JointVector min = vec({-1, -1}), max = vec({1, 1}), vmax = vec({2, 2});
-  // Within the limits.
-  TimedJointTrajectory fine({point(1.0, vec({0.5, -0.5})), point(2.0, vec({0.9, 0.0}))});
-  fine.start(state(vec({0, 0}), vec({0, 0}), vec({0, 0})));
-  EXPECT_FALSE(fine.findLimitViolation(min, max, vmax).found);
+  EXPECT_FALSE(violation({point(1.0, vec({0.5, -0.5})), point(2.0, vec({0.9, 0.0}))}).found) << "within the limits";
   // Too fast between points 0 and 1 on joint 1: 1.8 rad in 0.5 s.
-  TimedJointTrajectory fast({point(1.0, vec({0.0, -0.9})), point(1.5, vec({0.0, 0.9}))});
-  fast.start(state(vec({0, 0}), vec({0, 0}), vec({0, 0})));
-  const TrajectoryLimitViolation v = fast.findLimitViolation(min, max, vmax);
+  const TrajectoryLimitViolation v = violation({point(1.0, vec({0.0, -0.9})), point(1.5, vec({0.0, 0.9}))});
   ASSERT_TRUE(v.found);
   EXPECT_TRUE(v.velocity);
   EXPECT_EQ(v.point, 1);
   EXPECT_EQ(v.joint, 1);
   EXPECT_GT(std::abs(v.value), 2);
   // Points within the limits, but the velocities given carry joint 0 past 1 between them.
-  TimedJointTrajectory over({point(1.0, vec({0.9, 0}), vec({1.5, 0})), point(2.0, vec({0.9, 0}), vec({0, 0}))});
-  over.start(state(vec({0, 0}), vec({0, 0}), vec({0, 0})));
-  const TrajectoryLimitViolation w = over.findLimitViolation(min, max, vmax);
+  const TrajectoryLimitViolation w =
+      violation({point(1.0, vec({0.9, 0}), vec({1.5, 0})), point(2.0, vec({0.9, 0}), vec({0, 0}))});
   ASSERT_TRUE(w.found);
   EXPECT_FALSE(w.velocity);
   EXPECT_EQ(w.point, 1);
