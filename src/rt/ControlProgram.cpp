@@ -443,6 +443,7 @@ struct ControlProgram::Executor {
   std::vector<std::unique_ptr<List>> retired;  // lists replaced from the loop's own thread
   std::atomic<List*> list{nullptr};
   std::atomic<List*> inUse{nullptr};
+  std::atomic<std::uint64_t> releases{0};  // lists the loop has let go of
   SimulatedClock::Participant participant;
 
   // Statistics.
@@ -475,25 +476,35 @@ struct ControlProgram::Executor {
     if (SimulatedClock* s = sim.load()) s->interrupt();
   }
 
-  // Registry mutex held: publishes `next` to the loop; with `wait` (and not from the loop's own
-  // thread), returns once the loop holds no earlier list; frees the replaced lists the loop does
-  // not hold.
-  void replaceList(std::unique_ptr<List> next, bool wait) {
+  // Registry mutex held: publishes `next` to the loop and frees the replaced lists the loop does
+  // not hold. Returns a ticket for waitUntilReleased().
+  std::uint64_t replaceList(std::unique_ptr<List> next) {
     List* raw = next.get();
     int live = 0;
     if (raw != nullptr)
       for (const Impl* p : *raw) live += !p->loopEnded.load();
     participant.programs.store(live);
     list.exchange(raw);  // sequentially consistent with the loop's acquire()
+    const std::uint64_t ticket = releases.load();
     if (owned) retired.push_back(std::move(owned));
     owned = std::move(next);
-    if (wait && internal::currentExecutor != this)
-      for (List* held = inUse.load(); held != nullptr && held != raw; held = inUse.load()) std::this_thread::yield();
-    // The loop can only take the current list from now on: every other one it does not hold now
-    // is free.
+    freeRetired();
+    return ticket;
+  }
+
+  // Registry mutex held: frees every replaced list but the one the loop holds now (the loop can
+  // only take the current list from now on).
+  void freeRetired() {
     List* const held = inUse.load();
     retired.erase(std::remove_if(retired.begin(), retired.end(), [&](const auto& l) { return l.get() != held; }),
                   retired.end());
+  }
+
+  // Without the registry mutex (the loop may need it in this very cycle, to start a program), and
+  // not from the loop's own thread: returns once the loop holds no list published before the
+  // replaceList() that gave `ticket` (it holds none, or it has let go of a list since).
+  void waitUntilReleased(std::uint64_t ticket) const {
+    while (inUse.load() != nullptr && releases.load() == ticket) std::this_thread::yield();
   }
 
   // Loop: takes the current list (announced in `inUse`, then checked to be still current).
@@ -506,7 +517,10 @@ struct ControlProgram::Executor {
       l = now;
     }
   }
-  void release() noexcept { inUse.store(nullptr); }
+  void release() noexcept {
+    inUse.store(nullptr);
+    releases.fetch_add(1);
+  }
 
   // Loop: stops the programs that asked to, between cycles.
   void handleStopRequests() {
@@ -915,7 +929,7 @@ void ControlProgram::start() {
   if (e->owned) *next = *e->owned;
   next->push_back(&d);
   d.executorPrograms = next->size();
-  e->replaceList(std::move(next), false);
+  (void)e->replaceList(std::move(next));
   d.executor.store(e);
   // On the simulated clock a program whose first tick the executor has already run runs it in a
   // catch-up cycle: wake the executor to look.
@@ -952,6 +966,7 @@ void ControlProgram::stop() {
     d.endCv.wait(elock, [&] { return d.ended; });
   }
   std::thread finished;
+  std::uint64_t ticket = 0;
   {
     std::lock_guard<std::mutex> rlock(Executor::registryMutex());
     auto next = std::make_unique<Executor::List>();
@@ -962,7 +977,7 @@ void ControlProgram::stop() {
       e->overrunProgram.store(nullptr);
     }
     const bool empty = next->empty();
-    e->replaceList(empty ? nullptr : std::move(next), true);
+    ticket = e->replaceList(empty ? nullptr : std::move(next));
     d.executor.store(nullptr);
     if (empty) {
       e->exited = true;
@@ -970,6 +985,13 @@ void ControlProgram::stop() {
       e->wake();
       finished = std::move(e->thread);
     }
+  }
+  // This program's Impl may be freed once stop() returns: wait until the loop holds no list that
+  // names it, outside the registry's lock (a program in the current cycle may be starting another).
+  e->waitUntilReleased(ticket);
+  {
+    std::lock_guard<std::mutex> rlock(Executor::registryMutex());
+    e->freeRetired();
   }
   if (finished.joinable()) {
     finished.join();

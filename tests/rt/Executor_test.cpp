@@ -6,6 +6,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <thread>
 #include <vector>
@@ -332,6 +334,78 @@ TEST(Executor, AnOverrunIsNamedAfterTheProgramThatTookTheTime) {
   EXPECT_GE(hog.getStatistics().overruns, 1u);
   EXPECT_GE(idle.getStatistics().overruns, 1u);  // every program of the executor missed the deadline
   EXPECT_GE(hog.getStatistics().computationTime.max, idle.getStatistics().computationTime.max);
+}
+
+
+// A program started from inside a cycle of an executor while another program of the same executor
+// is being stopped from outside: stop() waits for the loop to let go of the list that still holds
+// the stopped program, and the loop's start() needs the executors' registry. Neither may wait for
+// the other while holding what the other needs (this hung before stop() waited outside the
+// registry's lock). A watchdog ends the process with a message if the scenario does not finish.
+class Notifier : public ControlProgram {
+ public:
+  explicit Notifier(const std::string& name) : ControlProgram(name) {}
+  ~Notifier() override { stop(); }
+  std::atomic<bool> exited{false};
+
+ protected:
+  void control() override {}
+  void exitControl() override { exited.store(true); }  // in the executor's thread, in the cycle that ends it
+};
+
+class Launcher : public ControlProgram {
+ public:
+  Launcher(const std::string& name, Notifier& victim, ControlProgram& late)
+      : ControlProgram(name), victim_(victim), late_(late) {}
+  ~Launcher() override { stop(); }
+  std::atomic<bool> launched{false};
+
+ protected:
+  void control() override {
+    if (launched.load() || !victim_.exited.load()) return;
+    // The victim ended at the start of this cycle; its stop() is now taking it out of the list and
+    // waits for this cycle to end. Give it time to get there, then start a program.
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    late_.start();
+    launched.store(true);
+  }
+
+ private:
+  Notifier& victim_;
+  ControlProgram& late_;
+};
+
+TEST(Executor, StartingAProgramInACycleWhileAnotherStopsDoesNotDeadlock) {
+  std::atomic<bool> done{false};
+  std::thread watchdog([&] {
+    for (int i = 0; i < 300 && !done.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (!done.load()) {
+      std::fprintf(stderr, "Executor deadlock: stop() and a start() from the loop wait for each other\n");
+      std::_Exit(3);
+    }
+  });
+  Notifier victim("victim"), late("late");
+  Launcher launcher("launcher", victim, late);
+  for (ControlProgram* p : {static_cast<ControlProgram*>(&victim), static_cast<ControlProgram*>(&late),
+                            static_cast<ControlProgram*>(&launcher)}) {
+    p->setClock(RealClock::instance());
+    p->setRate(250);
+    p->setPriority(12);  // an executor of its own among the tests' (rate and priority)
+  }
+  launcher.start();
+  victim.start();
+  while (launcher.getCycleCount() < 3) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  victim.stop();
+  while (!launcher.launched.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const std::uint64_t lateCycles = late.getCycleCount();
+  while (late.getCycleCount() < lateCycles + 3) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_EQ(executorsWith("late"), 1u);
+  EXPECT_EQ(executorsWith("victim"), 0u);
+  late.stop();
+  launcher.stop();
+  done.store(true);
+  watchdog.join();
+  EXPECT_FALSE(victim.isRunning());
 }
 
 }  // namespace
