@@ -407,6 +407,68 @@ std::atomic<int>& defaultThreadMode() {
   return mode;
 }
 thread_local const void* currentExecutor = nullptr;  // the executor whose loop runs in this thread
+
+// The CPUs a shared executor on the real clock spreads its programs over (setExecutorCpus()):
+// empty for one thread. Initially from RP_EXECUTOR_CPUS ("0,1"); a malformed value is ignored
+// with a message.
+struct ExecutorCpus {
+  std::mutex mutex;
+  std::vector<int> cpus;
+};
+ExecutorCpus& executorCpus() {
+  static auto* c = [] {
+    auto* x = new ExecutorCpus;
+    if (const char* e = std::getenv("RP_EXECUTOR_CPUS"); e != nullptr && *e != '\0') {
+      std::vector<int> cpus;
+      const std::string text = e;
+      std::size_t at = 0;
+      bool good = true;
+      while (good && at <= text.size()) {
+        const std::size_t comma = std::min(text.find(',', at), text.size());
+        const std::string item = text.substr(at, comma - at);
+        good = !item.empty() && item.size() < 5 && item.find_first_not_of("0123456789") == std::string::npos;
+        if (good) cpus.push_back(std::stoi(item));
+        at = comma + 1;
+      }
+      if (good && cpus.size() >= 2)
+        x->cpus = std::move(cpus);
+      else
+        std::fprintf(stderr, "rp: RP_EXECUTOR_CPUS='%s' is not a list of two or more CPU numbers (e.g. 0,1): ignored\n", e);
+    }
+    return x;
+  }();
+  return *c;
+}
+
+// A meeting point of an executor's threads between phases: spins (the threads run on CPUs of
+// their own), yielding after a while so that a machine without real-time scheduling still makes
+// progress. Real-time safe: yes (no lock, no system call while the others arrive in time).
+struct SpinBarrier {
+  unsigned count = 1;
+  std::atomic<unsigned> arrived{0};
+  std::atomic<std::uint64_t> round{0};
+  void wait() noexcept {
+    const std::uint64_t r = round.load(std::memory_order_acquire);
+    if (arrived.fetch_add(1, std::memory_order_acq_rel) + 1 == count) {
+      arrived.store(0, std::memory_order_relaxed);
+      round.fetch_add(1, std::memory_order_release);
+      return;
+    }
+    for (unsigned spins = 0; round.load(std::memory_order_acquire) == r; ++spins) {
+      if (spins < 20000)
+        cpuRelax();
+      else
+        std::this_thread::yield();
+    }
+  }
+  static void cpuRelax() noexcept {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#else
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+#endif
+  }
+};
 }  // namespace
 }  // namespace internal
 
@@ -445,6 +507,23 @@ struct ControlProgram::Executor {
   std::atomic<List*> inUse{nullptr};
   std::atomic<std::uint64_t> releases{0};  // lists the loop has let go of
   SimulatedClock::Participant participant;
+
+  // A spread executor (real clock, setExecutorCpus()): the loop's thread on spread[0] and a worker
+  // thread on each further CPU; program i of the list is stepped by thread i mod spread.size(),
+  // and the threads meet between the phases. The loop hands each cycle to the workers by `go`
+  // after writing the cycle's list and the time they sleep until next (`nextWake`).
+  std::vector<int> spread;
+  std::vector<std::thread> workers;
+  std::atomic<bool> workersQuit{false};
+  std::atomic<std::uint64_t> go{0};
+  std::atomic<std::int64_t> nextWake{0};
+  List* cycleList = nullptr;
+  internal::SpinBarrier barrier;
+
+  // The cycle being run (written by the loop before the phases, read by every thread of it).
+  bool cycleSimulated = false, cycleCatchUp = false;
+  double cycleClock = 0;  // the clock time of the cycle [s]
+  std::uint64_t cycleTick = 0;
 
   // Statistics.
   std::atomic<std::uint64_t> cycles{0}, overruns{0}, missed{0};
@@ -542,6 +621,109 @@ struct ControlProgram::Executor {
     return true;
   }
 
+  // Loop threads: whether program p takes part in the cycle being run.
+  bool active(const Impl* p) const noexcept {
+    return p->entered && !p->loopEnded.load(std::memory_order_relaxed) && (!cycleSimulated || cycleTick >= p->startTick) &&
+           (!cycleCatchUp || p->joining);
+  }
+
+  // Loop threads: the three phases of programs first, first + stride, ... of l, each program's
+  // time charged to it (from `start` [ns] on). With a stride (a spread executor) the threads meet
+  // after each phase, so that every control() sees every program's inputs of this cycle and every
+  // write follows every control(). Returns when this thread's phases ended [ns] (with a stride,
+  // when every thread's have).
+  std::int64_t phases(List& l, std::size_t first, std::size_t stride, std::int64_t start) noexcept {
+    std::int64_t last = start;
+    auto charge = [&](Impl* p) {
+      const std::int64_t now = internal::monotonicNanoseconds();
+      p->cycleNs += now - last;
+      last = now;
+    };
+    auto meet = [&] {
+      if (stride == 1) return;
+      barrier.wait();
+      last = internal::monotonicNanoseconds();
+    };
+    // Phase 1: parameters and inputs.
+    for (std::size_t i = first; i < l.size(); i += stride) {
+      Impl* p = l[i];
+      if (!active(p)) continue;
+      internal::currentLoop = p;
+      p->cycleNs = 0;
+      p->time.store(cycleClock, std::memory_order_relaxed);
+      p->applyParameters();
+      p->self.readInputs();
+      charge(p);
+    }
+    meet();
+    // Phase 2: control laws, each seeing every program's inputs of this cycle.
+    for (std::size_t i = first; i < l.size(); i += stride) {
+      Impl* p = l[i];
+      if (!active(p)) continue;
+      internal::currentLoop = p;
+      p->self.control();
+      charge(p);
+    }
+    meet();
+    // Phase 3: outputs.
+    for (std::size_t i = first; i < l.size(); i += stride) {
+      Impl* p = l[i];
+      if (!active(p)) continue;
+      internal::currentLoop = p;
+      p->self.writeOutputs();
+      charge(p);
+    }
+    meet();
+    internal::currentLoop = nullptr;
+    return last;
+  }
+
+  // A worker thread of a spread executor: sleeps until the loop's next deadline, takes the cycle
+  // the loop hands over and steps its share of the programs.
+  void workerMain(std::size_t w) {
+    internal::currentExecutor = this;
+    (void)internal::setUpRealTime(priority, spread[w]);
+    std::uint64_t seen = 0;
+    while (!workersQuit.load(std::memory_order_relaxed)) {
+      const std::int64_t until = nextWake.load(std::memory_order_relaxed);
+      for (std::int64_t now = internal::monotonicNanoseconds(); now < until && !workersQuit.load(std::memory_order_relaxed);
+           now = internal::monotonicNanoseconds()) {
+        const std::int64_t t = std::min<std::int64_t>(until, now + 10000000LL);
+        timespec ts{static_cast<time_t>(t / 1000000000LL), static_cast<long>(t % 1000000000LL)};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+      }
+      // The loop hands the cycle over a few microseconds after the deadline; after an overrun of
+      // its own or while it has no program it may be later: spin a while, then sleep in slices.
+      for (unsigned spins = 0; go.load(std::memory_order_acquire) == seen && !workersQuit.load(std::memory_order_relaxed);
+           ++spins) {
+        if (spins < 20000) {
+          internal::SpinBarrier::cpuRelax();
+        } else {
+          timespec ts{0, 50000};
+          nanosleep(&ts, nullptr);
+        }
+      }
+      if (workersQuit.load(std::memory_order_relaxed)) break;
+      seen = go.load(std::memory_order_acquire);
+      phases(*cycleList, w, spread.size(), internal::monotonicNanoseconds());
+    }
+    internal::currentExecutor = nullptr;
+  }
+
+  void startWorkers(std::int64_t firstDeadline) {
+    barrier.count = static_cast<unsigned>(spread.size());
+    go.store(0);
+    nextWake.store(firstDeadline);
+    workersQuit.store(false);
+    for (std::size_t w = 1; w < spread.size(); ++w) workers.emplace_back([this, w] { workerMain(w); });
+  }
+
+  void stopWorkers() {
+    workersQuit.store(true);
+    for (std::thread& t : workers) t.join();
+    workers.clear();
+  }
+
   // Loop: one cycle at clock time t (tick: the simulated clock's, woke: when the thread woke
   // [ns], latencyNs: how late, or -1 on the simulated clock). Returns the number of programs
   // still to step and sets `done` to the time the phases ended [ns].
@@ -571,42 +753,21 @@ struct ControlProgram::Executor {
           p->joining = true;
         }
       }
-      auto active = [&](const Impl* p) {
-        return p->entered && !p->loopEnded.load(std::memory_order_relaxed) && (!simulated || tick >= p->startTick) &&
-               (!catchUp || p->joining);
-      };
-      std::int64_t last = woke;
-      auto charge = [&](Impl* p) {
-        const std::int64_t now = internal::monotonicNanoseconds();
-        p->cycleNs += now - last;
-        last = now;
-      };
-      // Phase 1: parameters and inputs.
-      for (Impl* p : *l) {
-        if (!active(p)) continue;
-        internal::currentLoop = p;
-        p->cycleNs = 0;
-        p->time.store(t, std::memory_order_relaxed);
-        p->applyParameters();
-        p->self.readInputs();
-        charge(p);
-      }
-      // Phase 2: control laws, each seeing every program's inputs of this cycle.
-      for (Impl* p : *l) {
-        if (!active(p)) continue;
-        internal::currentLoop = p;
-        p->self.control();
-        charge(p);
-      }
-      // Phase 3: outputs.
-      for (Impl* p : *l) {
-        if (!active(p)) continue;
-        internal::currentLoop = p;
-        p->self.writeOutputs();
-        charge(p);
+      cycleSimulated = simulated;
+      cycleClock = t;
+      cycleTick = tick;
+      cycleCatchUp = catchUp;
+      std::int64_t done = 0;
+      if (spread.size() > 1) {
+        cycleList = l;
+        nextWake.store(deadline + period, std::memory_order_relaxed);
+        go.fetch_add(1, std::memory_order_release);
+        phases(*l, 0, spread.size(), woke);
+        done = internal::monotonicNanoseconds();
+      } else {
+        done = phases(*l, 0, 1, woke);
       }
       // Bookkeeping: logs, statistics, cycle limits.
-      const std::int64_t done = last;
       const bool overrun = !simulated && done > deadline + period;
       const Impl* slowest = nullptr;
       std::int64_t skipped = 0;
@@ -642,11 +803,12 @@ struct ControlProgram::Executor {
   }
 
   void runReal() {
-    realTime = internal::setUpRealTime(priority, cpu);
+    realTime = internal::setUpRealTime(priority, spread.size() > 1 ? spread[0] : cpu);
     const auto period = static_cast<std::int64_t>(std::llround(1e9 / rate));
     const std::int64_t epoch = RealClock::instance().epochNanoseconds();
     // The first deadline is one period away (as in cyclictest), so every wake-up is a real one.
     std::int64_t deadline = internal::monotonicNanoseconds() + period;
+    if (spread.size() > 1) startWorkers(deadline);
     while (!quit.load(std::memory_order_relaxed)) {
       // Sleep until the absolute deadline, in slices so that a stop is never kept waiting long.
       // The clock is read first thing after each wake-up: that reading is the one timed.
@@ -713,6 +875,7 @@ struct ControlProgram::Executor {
       s->detach(participant);
     } else {
       runReal();
+      stopWorkers();
     }
     // Programs whose stop request came with the end (stop() waits for them).
     handleStopRequests();
@@ -804,6 +967,26 @@ void ControlProgram::setThreadMode(ThreadMode mode) {
   impl_->threadMode = mode;
 }
 ThreadMode ControlProgram::getThreadMode() const { return impl_->threadMode; }
+void ControlProgram::setExecutorCpus(const std::vector<int>& cpus) {
+  if (cpus.size() == 1)
+    throw std::invalid_argument("ControlProgram::setExecutorCpus: one CPU is no spread; pin the programs with setCpuAffinity()");
+  for (std::size_t i = 0; i < cpus.size(); ++i) {
+    if (cpus[i] < 0 || cpus[i] >= CPU_SETSIZE)
+      throw std::invalid_argument("ControlProgram::setExecutorCpus: CPU " + std::to_string(cpus[i]) + " is not in 0.." +
+                                  std::to_string(CPU_SETSIZE - 1));
+    for (std::size_t j = 0; j < i; ++j)
+      if (cpus[j] == cpus[i])
+        throw std::invalid_argument("ControlProgram::setExecutorCpus: CPU " + std::to_string(cpus[i]) + " is listed twice");
+  }
+  std::lock_guard<std::mutex> lock(internal::executorCpus().mutex);
+  internal::executorCpus().cpus = cpus;
+}
+
+std::vector<int> ControlProgram::getExecutorCpus() {
+  std::lock_guard<std::mutex> lock(internal::executorCpus().mutex);
+  return internal::executorCpus().cpus;
+}
+
 void ControlProgram::setDefaultThreadMode(ThreadMode mode) { internal::defaultThreadMode().store(static_cast<int>(mode)); }
 ThreadMode ControlProgram::getDefaultThreadMode() { return static_cast<ThreadMode>(internal::defaultThreadMode().load()); }
 
@@ -910,6 +1093,11 @@ void ControlProgram::start() {
     e->own = own;
     e->ticksPerCycle = ticksPerCycle;
     e->firstTick = d.startTick;
+    e->spread.clear();
+    if (!own && d.cpu < 0 && sim == nullptr) {
+      std::lock_guard<std::mutex> cpusLock(internal::executorCpus().mutex);
+      e->spread = internal::executorCpus().cpus;
+    }
     e->exited = false;
     e->quit = false;
     e->attention = false;
@@ -1050,6 +1238,7 @@ std::vector<ExecutorStatistics> ControlProgram::getExecutorStatistics() {
     s.rate = e->rate;
     s.priority = e->priority;
     s.cpu = e->cpu;
+    s.cpus = e->spread;
     s.ownThread = e->own;
     s.simulatedClock = e->clock != nullptr && e->clock->isSimulated();
     s.realTimeScheduling = e->realTime.load();
