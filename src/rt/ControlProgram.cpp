@@ -23,6 +23,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "CycleSignal.hpp"
 #include "LogChannel.hpp"
 #include "rp/core/Configuration.hpp"
 #include "rp/core/ObjectManager.hpp"
@@ -797,6 +798,7 @@ struct ControlProgram::Executor {
         overrunNs.store(slowest->cycleNs, std::memory_order_relaxed);
       }
       internal::currentLoop = nullptr;
+      internal::cycleEnded();  // for threads that publish each cycle's state (CycleSignal.hpp)
     }
     release();
     return live;
