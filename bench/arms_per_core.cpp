@@ -25,8 +25,13 @@
 //
 // Each mode's result line begins `arms_per_core MODE N ...`.
 //
-// Usage: arms_per_core [--mode M] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
+// --integrator rk4|euler (default rk4, the simulation's default) chooses how each simulated arm
+// integrates its dynamics (rp.cfg's `integrator`, written for the arms into a configuration file
+// in /tmp): RK4 takes four forward-dynamics evaluations per step, semi-implicit Euler one.
+//
+// Usage: arms_per_core [--mode M] [--integrator I] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
 #include <sched.h>
+#include <unistd.h>
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -154,7 +159,7 @@ Trial attempt(int n, double seconds, int tries) {
 int main(int argc, char** argv) {
   int cpu = 1, start = 16, max = 4096, resolution = 4, tries = 3;
   double seconds = 5;
-  std::string mode = "both";
+  std::string mode = "both", integrator = "rk4";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> const char* {
@@ -168,6 +173,12 @@ int main(int argc, char** argv) {
       mode = value();
       if (mode != "shared" && mode != "own" && mode != "both") {
         std::fprintf(stderr, "arms_per_core: --mode must be shared, own or both\n");
+        return 2;
+      }
+    } else if (a == "--integrator") {
+      integrator = value();
+      if (integrator != "rk4" && integrator != "euler") {
+        std::fprintf(stderr, "arms_per_core: --integrator must be rk4 or euler\n");
         return 2;
       }
     } else if (a == "--cpu") {
@@ -184,7 +195,7 @@ int main(int argc, char** argv) {
       resolution = std::max(1, std::atoi(value()));
     } else {
       std::fprintf(stderr,
-                   "usage: arms_per_core [--mode shared|own|both] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
+                   "usage: arms_per_core [--mode shared|own|both] [--integrator rk4|euler] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
       return 2;
     }
   }
@@ -200,13 +211,25 @@ int main(int argc, char** argv) {
     return 1;
   }
   RoboticPlatform::setSimulationModeOn();  // real clock (the default), simulated arms
+  // The arms' sections: arm0 ... arm<max-1>, each a Puma 560 with the chosen integrator.
+  const std::string config = "/tmp/arms_per_core_" + std::to_string(getpid()) + ".cfg";
+  if (FILE* f = std::fopen(config.c_str(), "w")) {
+    for (int i = 0; i < max; ++i) std::fprintf(f, "[arm%d]\nclass Puma560\nintegrator %s\n\n", i, integrator.c_str());
+    std::fclose(f);
+  } else {
+    std::fprintf(stderr, "arms_per_core: cannot write %s: %s\n", config.c_str(), std::strerror(errno));
+    return 1;
+  }
+  RoboticPlatform::setConfigurationFileName(config);
+  RoboticPlatform::loadConfiguration();
 
   std::vector<std::string> modes;
   if (mode == "both" || mode == "shared") modes.push_back("shared");
   if (mode == "both" || mode == "own") modes.push_back("own");
   for (const std::string& m : modes) {
     ControlProgram::setDefaultThreadMode(m == "own" ? ThreadMode::Own : ThreadMode::Shared);
-    std::printf("mode %s: simulated Puma 560 arms at 1 kHz on CPU %d, %.1f s per trial\n", m.c_str(), cpu, seconds);
+    std::printf("mode %s: simulated Puma 560 arms (integrator %s) at 1 kHz on CPU %d, %.1f s per trial\n", m.c_str(),
+                integrator.c_str(), cpu, seconds);
     Trial best;
     int bad = 0;
     for (int n = start; n <= max; n *= 2) {
@@ -241,5 +264,6 @@ int main(int argc, char** argv) {
                 m.c_str(), best.arms, best.cycleP50, best.cycleP99, best.wakeupP99, best.wakeupMax, best.cpuPerCycle,
                 best.realTime ? "SCHED_FIFO" : "normal");
   }
+  std::remove(config.c_str());
   return 0;
 }

@@ -23,6 +23,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "CycleSignal.hpp"
 #include "LogChannel.hpp"
 #include "rp/core/Configuration.hpp"
 #include "rp/core/ObjectManager.hpp"
@@ -407,6 +408,68 @@ std::atomic<int>& defaultThreadMode() {
   return mode;
 }
 thread_local const void* currentExecutor = nullptr;  // the executor whose loop runs in this thread
+
+// The CPUs a shared executor on the real clock spreads its programs over (setExecutorCpus()):
+// empty for one thread. Initially from RP_EXECUTOR_CPUS ("0,1"); a malformed value is ignored
+// with a message.
+struct ExecutorCpus {
+  std::mutex mutex;
+  std::vector<int> cpus;
+};
+ExecutorCpus& executorCpus() {
+  static auto* c = [] {
+    auto* x = new ExecutorCpus;
+    if (const char* e = std::getenv("RP_EXECUTOR_CPUS"); e != nullptr && *e != '\0') {
+      std::vector<int> cpus;
+      const std::string text = e;
+      std::size_t at = 0;
+      bool good = true;
+      while (good && at <= text.size()) {
+        const std::size_t comma = std::min(text.find(',', at), text.size());
+        const std::string item = text.substr(at, comma - at);
+        good = !item.empty() && item.size() < 5 && item.find_first_not_of("0123456789") == std::string::npos;
+        if (good) cpus.push_back(std::stoi(item));
+        at = comma + 1;
+      }
+      if (good && cpus.size() >= 2)
+        x->cpus = std::move(cpus);
+      else
+        std::fprintf(stderr, "rp: RP_EXECUTOR_CPUS='%s' is not a list of two or more CPU numbers (e.g. 0,1): ignored\n", e);
+    }
+    return x;
+  }();
+  return *c;
+}
+
+// A meeting point of an executor's threads between phases: spins (the threads run on CPUs of
+// their own), yielding after a while so that a machine without real-time scheduling still makes
+// progress. Real-time safe: yes (no lock, no system call while the others arrive in time).
+struct SpinBarrier {
+  unsigned count = 1;
+  std::atomic<unsigned> arrived{0};
+  std::atomic<std::uint64_t> round{0};
+  void wait() noexcept {
+    const std::uint64_t r = round.load(std::memory_order_acquire);
+    if (arrived.fetch_add(1, std::memory_order_acq_rel) + 1 == count) {
+      arrived.store(0, std::memory_order_relaxed);
+      round.fetch_add(1, std::memory_order_release);
+      return;
+    }
+    for (unsigned spins = 0; round.load(std::memory_order_acquire) == r; ++spins) {
+      if (spins < 20000)
+        cpuRelax();
+      else
+        std::this_thread::yield();
+    }
+  }
+  static void cpuRelax() noexcept {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#else
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+#endif
+  }
+};
 }  // namespace
 }  // namespace internal
 
@@ -443,7 +506,25 @@ struct ControlProgram::Executor {
   std::vector<std::unique_ptr<List>> retired;  // lists replaced from the loop's own thread
   std::atomic<List*> list{nullptr};
   std::atomic<List*> inUse{nullptr};
+  std::atomic<std::uint64_t> releases{0};  // lists the loop has let go of
   SimulatedClock::Participant participant;
+
+  // A spread executor (real clock, setExecutorCpus()): the loop's thread on spread[0] and a worker
+  // thread on each further CPU; program i of the list is stepped by thread i mod spread.size(),
+  // and the threads meet between the phases. The loop hands each cycle to the workers by `go`
+  // after writing the cycle's list and the time they sleep until next (`nextWake`).
+  std::vector<int> spread;
+  std::vector<std::thread> workers;
+  std::atomic<bool> workersQuit{false};
+  std::atomic<std::uint64_t> go{0};
+  std::atomic<std::int64_t> nextWake{0};
+  List* cycleList = nullptr;
+  internal::SpinBarrier barrier;
+
+  // The cycle being run (written by the loop before the phases, read by every thread of it).
+  bool cycleSimulated = false, cycleCatchUp = false;
+  double cycleClock = 0;  // the clock time of the cycle [s]
+  std::uint64_t cycleTick = 0;
 
   // Statistics.
   std::atomic<std::uint64_t> cycles{0}, overruns{0}, missed{0};
@@ -475,25 +556,35 @@ struct ControlProgram::Executor {
     if (SimulatedClock* s = sim.load()) s->interrupt();
   }
 
-  // Registry mutex held: publishes `next` to the loop; with `wait` (and not from the loop's own
-  // thread), returns once the loop holds no earlier list; frees the replaced lists the loop does
-  // not hold.
-  void replaceList(std::unique_ptr<List> next, bool wait) {
+  // Registry mutex held: publishes `next` to the loop and frees the replaced lists the loop does
+  // not hold. Returns a ticket for waitUntilReleased().
+  std::uint64_t replaceList(std::unique_ptr<List> next) {
     List* raw = next.get();
     int live = 0;
     if (raw != nullptr)
       for (const Impl* p : *raw) live += !p->loopEnded.load();
     participant.programs.store(live);
     list.exchange(raw);  // sequentially consistent with the loop's acquire()
+    const std::uint64_t ticket = releases.load();
     if (owned) retired.push_back(std::move(owned));
     owned = std::move(next);
-    if (wait && internal::currentExecutor != this)
-      for (List* held = inUse.load(); held != nullptr && held != raw; held = inUse.load()) std::this_thread::yield();
-    // The loop can only take the current list from now on: every other one it does not hold now
-    // is free.
+    freeRetired();
+    return ticket;
+  }
+
+  // Registry mutex held: frees every replaced list but the one the loop holds now (the loop can
+  // only take the current list from now on).
+  void freeRetired() {
     List* const held = inUse.load();
     retired.erase(std::remove_if(retired.begin(), retired.end(), [&](const auto& l) { return l.get() != held; }),
                   retired.end());
+  }
+
+  // Without the registry mutex (the loop may need it in this very cycle, to start a program), and
+  // not from the loop's own thread: returns once the loop holds no list published before the
+  // replaceList() that gave `ticket` (it holds none, or it has let go of a list since).
+  void waitUntilReleased(std::uint64_t ticket) const {
+    while (inUse.load() != nullptr && releases.load() == ticket) std::this_thread::yield();
   }
 
   // Loop: takes the current list (announced in `inUse`, then checked to be still current).
@@ -506,7 +597,10 @@ struct ControlProgram::Executor {
       l = now;
     }
   }
-  void release() noexcept { inUse.store(nullptr); }
+  void release() noexcept {
+    inUse.store(nullptr);
+    releases.fetch_add(1);
+  }
 
   // Loop: stops the programs that asked to, between cycles.
   void handleStopRequests() {
@@ -526,6 +620,109 @@ struct ControlProgram::Executor {
         if (!p->loopEnded.load()) return false;
     exited = true;
     return true;
+  }
+
+  // Loop threads: whether program p takes part in the cycle being run.
+  bool active(const Impl* p) const noexcept {
+    return p->entered && !p->loopEnded.load(std::memory_order_relaxed) && (!cycleSimulated || cycleTick >= p->startTick) &&
+           (!cycleCatchUp || p->joining);
+  }
+
+  // Loop threads: the three phases of programs first, first + stride, ... of l, each program's
+  // time charged to it (from `start` [ns] on). With a stride (a spread executor) the threads meet
+  // after each phase, so that every control() sees every program's inputs of this cycle and every
+  // write follows every control(). Returns when this thread's phases ended [ns] (with a stride,
+  // when every thread's have).
+  std::int64_t phases(List& l, std::size_t first, std::size_t stride, std::int64_t start) noexcept {
+    std::int64_t last = start;
+    auto charge = [&](Impl* p) {
+      const std::int64_t now = internal::monotonicNanoseconds();
+      p->cycleNs += now - last;
+      last = now;
+    };
+    auto meet = [&] {
+      if (stride == 1) return;
+      barrier.wait();
+      last = internal::monotonicNanoseconds();
+    };
+    // Phase 1: parameters and inputs.
+    for (std::size_t i = first; i < l.size(); i += stride) {
+      Impl* p = l[i];
+      if (!active(p)) continue;
+      internal::currentLoop = p;
+      p->cycleNs = 0;
+      p->time.store(cycleClock, std::memory_order_relaxed);
+      p->applyParameters();
+      p->self.readInputs();
+      charge(p);
+    }
+    meet();
+    // Phase 2: control laws, each seeing every program's inputs of this cycle.
+    for (std::size_t i = first; i < l.size(); i += stride) {
+      Impl* p = l[i];
+      if (!active(p)) continue;
+      internal::currentLoop = p;
+      p->self.control();
+      charge(p);
+    }
+    meet();
+    // Phase 3: outputs.
+    for (std::size_t i = first; i < l.size(); i += stride) {
+      Impl* p = l[i];
+      if (!active(p)) continue;
+      internal::currentLoop = p;
+      p->self.writeOutputs();
+      charge(p);
+    }
+    meet();
+    internal::currentLoop = nullptr;
+    return last;
+  }
+
+  // A worker thread of a spread executor: sleeps until the loop's next deadline, takes the cycle
+  // the loop hands over and steps its share of the programs.
+  void workerMain(std::size_t w) {
+    internal::currentExecutor = this;
+    (void)internal::setUpRealTime(priority, spread[w]);
+    std::uint64_t seen = 0;
+    while (!workersQuit.load(std::memory_order_relaxed)) {
+      const std::int64_t until = nextWake.load(std::memory_order_relaxed);
+      for (std::int64_t now = internal::monotonicNanoseconds(); now < until && !workersQuit.load(std::memory_order_relaxed);
+           now = internal::monotonicNanoseconds()) {
+        const std::int64_t t = std::min<std::int64_t>(until, now + 10000000LL);
+        timespec ts{static_cast<time_t>(t / 1000000000LL), static_cast<long>(t % 1000000000LL)};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+      }
+      // The loop hands the cycle over a few microseconds after the deadline; after an overrun of
+      // its own or while it has no program it may be later: spin a while, then sleep in slices.
+      for (unsigned spins = 0; go.load(std::memory_order_acquire) == seen && !workersQuit.load(std::memory_order_relaxed);
+           ++spins) {
+        if (spins < 20000) {
+          internal::SpinBarrier::cpuRelax();
+        } else {
+          timespec ts{0, 50000};
+          nanosleep(&ts, nullptr);
+        }
+      }
+      if (workersQuit.load(std::memory_order_relaxed)) break;
+      seen = go.load(std::memory_order_acquire);
+      phases(*cycleList, w, spread.size(), internal::monotonicNanoseconds());
+    }
+    internal::currentExecutor = nullptr;
+  }
+
+  void startWorkers(std::int64_t firstDeadline) {
+    barrier.count = static_cast<unsigned>(spread.size());
+    go.store(0);
+    nextWake.store(firstDeadline);
+    workersQuit.store(false);
+    for (std::size_t w = 1; w < spread.size(); ++w) workers.emplace_back([this, w] { workerMain(w); });
+  }
+
+  void stopWorkers() {
+    workersQuit.store(true);
+    for (std::thread& t : workers) t.join();
+    workers.clear();
   }
 
   // Loop: one cycle at clock time t (tick: the simulated clock's, woke: when the thread woke
@@ -557,42 +754,21 @@ struct ControlProgram::Executor {
           p->joining = true;
         }
       }
-      auto active = [&](const Impl* p) {
-        return p->entered && !p->loopEnded.load(std::memory_order_relaxed) && (!simulated || tick >= p->startTick) &&
-               (!catchUp || p->joining);
-      };
-      std::int64_t last = woke;
-      auto charge = [&](Impl* p) {
-        const std::int64_t now = internal::monotonicNanoseconds();
-        p->cycleNs += now - last;
-        last = now;
-      };
-      // Phase 1: parameters and inputs.
-      for (Impl* p : *l) {
-        if (!active(p)) continue;
-        internal::currentLoop = p;
-        p->cycleNs = 0;
-        p->time.store(t, std::memory_order_relaxed);
-        p->applyParameters();
-        p->self.readInputs();
-        charge(p);
-      }
-      // Phase 2: control laws, each seeing every program's inputs of this cycle.
-      for (Impl* p : *l) {
-        if (!active(p)) continue;
-        internal::currentLoop = p;
-        p->self.control();
-        charge(p);
-      }
-      // Phase 3: outputs.
-      for (Impl* p : *l) {
-        if (!active(p)) continue;
-        internal::currentLoop = p;
-        p->self.writeOutputs();
-        charge(p);
+      cycleSimulated = simulated;
+      cycleClock = t;
+      cycleTick = tick;
+      cycleCatchUp = catchUp;
+      std::int64_t done = 0;
+      if (spread.size() > 1) {
+        cycleList = l;
+        nextWake.store(deadline + period, std::memory_order_relaxed);
+        go.fetch_add(1, std::memory_order_release);
+        phases(*l, 0, spread.size(), woke);
+        done = internal::monotonicNanoseconds();
+      } else {
+        done = phases(*l, 0, 1, woke);
       }
       // Bookkeeping: logs, statistics, cycle limits.
-      const std::int64_t done = last;
       const bool overrun = !simulated && done > deadline + period;
       const Impl* slowest = nullptr;
       std::int64_t skipped = 0;
@@ -622,17 +798,19 @@ struct ControlProgram::Executor {
         overrunNs.store(slowest->cycleNs, std::memory_order_relaxed);
       }
       internal::currentLoop = nullptr;
+      internal::cycleEnded();  // for threads that publish each cycle's state (CycleSignal.hpp)
     }
     release();
     return live;
   }
 
   void runReal() {
-    realTime = internal::setUpRealTime(priority, cpu);
+    realTime = internal::setUpRealTime(priority, spread.size() > 1 ? spread[0] : cpu);
     const auto period = static_cast<std::int64_t>(std::llround(1e9 / rate));
     const std::int64_t epoch = RealClock::instance().epochNanoseconds();
     // The first deadline is one period away (as in cyclictest), so every wake-up is a real one.
     std::int64_t deadline = internal::monotonicNanoseconds() + period;
+    if (spread.size() > 1) startWorkers(deadline);
     while (!quit.load(std::memory_order_relaxed)) {
       // Sleep until the absolute deadline, in slices so that a stop is never kept waiting long.
       // The clock is read first thing after each wake-up: that reading is the one timed.
@@ -699,6 +877,7 @@ struct ControlProgram::Executor {
       s->detach(participant);
     } else {
       runReal();
+      stopWorkers();
     }
     // Programs whose stop request came with the end (stop() waits for them).
     handleStopRequests();
@@ -790,6 +969,26 @@ void ControlProgram::setThreadMode(ThreadMode mode) {
   impl_->threadMode = mode;
 }
 ThreadMode ControlProgram::getThreadMode() const { return impl_->threadMode; }
+void ControlProgram::setExecutorCpus(const std::vector<int>& cpus) {
+  if (cpus.size() == 1)
+    throw std::invalid_argument("ControlProgram::setExecutorCpus: one CPU is no spread; pin the programs with setCpuAffinity()");
+  for (std::size_t i = 0; i < cpus.size(); ++i) {
+    if (cpus[i] < 0 || cpus[i] >= CPU_SETSIZE)
+      throw std::invalid_argument("ControlProgram::setExecutorCpus: CPU " + std::to_string(cpus[i]) + " is not in 0.." +
+                                  std::to_string(CPU_SETSIZE - 1));
+    for (std::size_t j = 0; j < i; ++j)
+      if (cpus[j] == cpus[i])
+        throw std::invalid_argument("ControlProgram::setExecutorCpus: CPU " + std::to_string(cpus[i]) + " is listed twice");
+  }
+  std::lock_guard<std::mutex> lock(internal::executorCpus().mutex);
+  internal::executorCpus().cpus = cpus;
+}
+
+std::vector<int> ControlProgram::getExecutorCpus() {
+  std::lock_guard<std::mutex> lock(internal::executorCpus().mutex);
+  return internal::executorCpus().cpus;
+}
+
 void ControlProgram::setDefaultThreadMode(ThreadMode mode) { internal::defaultThreadMode().store(static_cast<int>(mode)); }
 ThreadMode ControlProgram::getDefaultThreadMode() { return static_cast<ThreadMode>(internal::defaultThreadMode().load()); }
 
@@ -896,6 +1095,11 @@ void ControlProgram::start() {
     e->own = own;
     e->ticksPerCycle = ticksPerCycle;
     e->firstTick = d.startTick;
+    e->spread.clear();
+    if (!own && d.cpu < 0 && sim == nullptr) {
+      std::lock_guard<std::mutex> cpusLock(internal::executorCpus().mutex);
+      e->spread = internal::executorCpus().cpus;
+    }
     e->exited = false;
     e->quit = false;
     e->attention = false;
@@ -915,7 +1119,7 @@ void ControlProgram::start() {
   if (e->owned) *next = *e->owned;
   next->push_back(&d);
   d.executorPrograms = next->size();
-  e->replaceList(std::move(next), false);
+  (void)e->replaceList(std::move(next));
   d.executor.store(e);
   // On the simulated clock a program whose first tick the executor has already run runs it in a
   // catch-up cycle: wake the executor to look.
@@ -952,6 +1156,7 @@ void ControlProgram::stop() {
     d.endCv.wait(elock, [&] { return d.ended; });
   }
   std::thread finished;
+  std::uint64_t ticket = 0;
   {
     std::lock_guard<std::mutex> rlock(Executor::registryMutex());
     auto next = std::make_unique<Executor::List>();
@@ -962,7 +1167,7 @@ void ControlProgram::stop() {
       e->overrunProgram.store(nullptr);
     }
     const bool empty = next->empty();
-    e->replaceList(empty ? nullptr : std::move(next), true);
+    ticket = e->replaceList(empty ? nullptr : std::move(next));
     d.executor.store(nullptr);
     if (empty) {
       e->exited = true;
@@ -970,6 +1175,13 @@ void ControlProgram::stop() {
       e->wake();
       finished = std::move(e->thread);
     }
+  }
+  // This program's Impl may be freed once stop() returns: wait until the loop holds no list that
+  // names it, outside the registry's lock (a program in the current cycle may be starting another).
+  e->waitUntilReleased(ticket);
+  {
+    std::lock_guard<std::mutex> rlock(Executor::registryMutex());
+    e->freeRetired();
   }
   if (finished.joinable()) {
     finished.join();
@@ -1028,6 +1240,7 @@ std::vector<ExecutorStatistics> ControlProgram::getExecutorStatistics() {
     s.rate = e->rate;
     s.priority = e->priority;
     s.cpu = e->cpu;
+    s.cpus = e->spread;
     s.ownThread = e->own;
     s.simulatedClock = e->clock != nullptr && e->clock->isSimulated();
     s.realTimeScheduling = e->realTime.load();

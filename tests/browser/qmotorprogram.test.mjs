@@ -40,6 +40,12 @@ describe('QMotor program control on qmotor_cell -qmotor', () => {
   it('stops, starts and restarts the puma: the state changes and the arm holds', async () => {
     await open('puma');
     await waitInPage(page, () => window.rp.program.running && document.getElementById('prog-state').textContent.startsWith('running'));
+    // The program's timing (docs/realtime.md, Timing): its computation time and its executor's
+    // overruns in the line, the rest in the line's tooltip.
+    assert.match(await page.evaluate(() => document.getElementById('prog-state').textContent),
+      /^running, \d+ cycles · computation p99 \d+\.\d µs · \d+ overruns/);
+    assert.match(await page.evaluate(() => document.getElementById('prog-state').title),
+      /^computation p50 \d+\.\d µs, p99 \d+\.\d µs, max \d+\.\d µs; (executor of \d+|own thread): wake-up p99 \d+\.\d µs, \d+ overruns/);
     await sleep(500);
     const before = await jointsOf(page);
     await page.click('#prog-stop');

@@ -178,6 +178,43 @@ TEST_F(QMotorRequestsOnObjects, SaveThenLoadRoundTripsAChangedGain) {
   EXPECT_EQ(error(t, R"({"action":"load","file":"../rp.cfg"})").rfind("'file' must be a file name ending in .cfg", 0), 0u);
 }
 
+// A program that takes 20 periods in one cycle (its 5th): an overrun of its executor, whatever the
+// machine, named after it.
+class Hog : public PhysicalObject, public ControlProgram {
+ public:
+  explicit Hog(const std::string& name) : PhysicalObject(name), ControlProgram(name) {
+    setLogWriter(nullptr);
+    startControlLoop();
+  }
+  ~Hog() override { stopControlLoop(); }
+  ControlProgram* getControlProgram() override { return this; }
+
+ protected:
+  void control() override {
+    if (getCycleCount() != 5) return;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long>(20e6 / getRate()));
+    while (std::chrono::steady_clock::now() < until) {
+    }
+  }
+};
+
+// The status carries the program's timing (docs/realtime.md, Timing) for QMotor's program line:
+// its own computation time, its executor's size, wake-up latency, overruns and the program that
+// took the time in the last overrun.
+TEST_F(QMotorRequestsOnObjects, StatusCarriesTheProgramsTimingAndItsExecutors) {
+  Tunable t("tune");
+  Hog hog("hog");
+  while (t.getCycleCount() < 20 || hog.getCycleCount() < 20) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const json timing = run(t, R"({"action":"status"})")["status"]["timing"];
+  EXPECT_EQ(timing["executorPrograms"], 2) << timing.dump();
+  EXPECT_EQ(timing["ownThread"], false);
+  EXPECT_GE(timing["overruns"].get<int>(), 1);
+  EXPECT_EQ(timing["lastOverrunProgram"], "hog");
+  EXPECT_GE(timing["computationP99"].get<double>(), timing["computationP50"].get<double>());
+  EXPECT_GE(timing["computationMax"].get<double>(), timing["computationP99"].get<double>());
+  EXPECT_GE(timing["wakeupP99"].get<double>(), 0.0);
+}
+
 TEST_F(QMotorRequestsOnObjects, ABadFileIsRefusedWithFileAndLineAndChangesNothing) {
   Tunable t("tune");
   std::ofstream(dir_ / "bad.cfg") << "gain 9\nkp 1 2\ngian 3\n";

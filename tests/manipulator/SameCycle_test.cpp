@@ -66,12 +66,12 @@ std::map<double, double> column(const std::string& csv, const std::string& colum
   return out;
 }
 
-TEST_F(SameCycleTest, FollowerUsesTheLeadersMeasurementOfTheSameCycle) {
-  // The follower is made (and started) first: it is stepped first in every phase.
-  Puma560 follower("follower"), leader("leader");
-  ASSERT_EQ(follower.getThreadMode(), ThreadMode::Shared);
-  ASSERT_TRUE(leader.waitForCycles(5));
-  simClock().pause();
+// Drives the leader along a ramp, the follower to the leader's measured position, under load (two
+// threads spinning on the machine's two cores), and checks in their logs that the follower's
+// setpoint of every cycle is the leader's reading of that cycle. `pause`/`resume` hold the clock
+// while the captures are set up (nothing on the real clock).
+void checkFollowerUsesTheSameCycle(Puma560& follower, Puma560& leader, void (*pause)(), void (*resume)()) {
+  pause();
   test::JointRamp ramp(0, 0.3);
   FollowMeasured follow(leader);
   leader.setTrajectoryGenerator(ramp);
@@ -79,7 +79,6 @@ TEST_F(SameCycleTest, FollowerUsesTheLeadersMeasurementOfTheSameCycle) {
   constexpr std::size_t kRows = 400;
   leader.setLogCapture(LogCaptureSettings{{"q"}, 1, kRows, "", 0, true});
   follower.setLogCapture(LogCaptureSettings{{"qdes"}, 1, kRows, "", 0, true});
-  // Load: two threads spinning on the machine's two cores while the arms run.
   std::atomic<bool> loaded{true};
   std::vector<std::thread> load;
   for (int i = 0; i < 2; ++i)
@@ -87,12 +86,12 @@ TEST_F(SameCycleTest, FollowerUsesTheLeadersMeasurementOfTheSameCycle) {
       volatile double x = 0;
       while (loaded.load(std::memory_order_relaxed)) x = x + 1;
     });
-  simClock().resume();
+  resume();
   while (leader.getLogCaptureStatus().rows < kRows || follower.getLogCaptureStatus().rows < kRows)
     ASSERT_TRUE(leader.waitForCycles(10));
   loaded = false;
   for (auto& t : load) t.join();
-  simClock().pause();
+  pause();
 
   const auto measured = column(leader.getLogCaptureCsv(), "leader.q[0]");
   const auto setpoint = column(follower.getLogCaptureCsv(), "follower.qdes[0]");
@@ -110,13 +109,41 @@ TEST_F(SameCycleTest, FollowerUsesTheLeadersMeasurementOfTheSameCycle) {
     previous += it->second == last && last != q;
     last = q;
   }
-  EXPECT_GE(rows, kRows - 10);  // the two captures began in the same cycle or one apart
+  EXPECT_GE(rows, kRows - 10);  // the two captures began in the same cycle or a few apart
   EXPECT_EQ(same, rows);
   EXPECT_EQ(previous, 0u);
   // The leader moved in (nearly) every row, so the previous row's reading would not do.
   EXPECT_GT(measured.rbegin()->second - measured.begin()->second, 0.05);
   EXPECT_EQ(leader.getErrorCode(), 0) << leader.getErrorStatus().message;
   EXPECT_EQ(follower.getErrorCode(), 0) << follower.getErrorStatus().message;
+}
+
+TEST_F(SameCycleTest, FollowerUsesTheLeadersMeasurementOfTheSameCycle) {
+  // The follower is made (and started) first: it is stepped first in every phase.
+  Puma560 follower("follower"), leader("leader");
+  ASSERT_EQ(follower.getThreadMode(), ThreadMode::Shared);
+  ASSERT_TRUE(leader.waitForCycles(5));
+  checkFollowerUsesTheSameCycle(
+      follower, leader, [] { simClock().pause(); }, [] { simClock().resume(); });
+}
+
+// The same on the real clock with the executor spread over both CPUs (setExecutorCpus()): the
+// follower is stepped by the loop's thread, the leader by the worker on the other CPU, and the
+// threads meet between the phases.
+TEST_F(SameCycleTest, FollowerOnAnotherCpuOfASpreadExecutorUsesTheSameCycle) {
+  RoboticPlatform::useRealClock();
+  ControlProgram::setExecutorCpus({0, 1});
+  {
+    Puma560 follower("follower"), leader("leader");
+    ControlProgram::setExecutorCpus({});
+    bool spread = false;
+    for (const auto& e : ControlProgram::getExecutorStatistics())
+      if (e.programs == std::vector<std::string>{"follower", "leader"}) spread = e.cpus == std::vector<int>{0, 1};
+    EXPECT_TRUE(spread);
+    ASSERT_TRUE(leader.waitForCycles(5));
+    checkFollowerUsesTheSameCycle(follower, leader, [] {}, [] {});
+  }
+  simClock();  // back to the simulated clock for the other tests
 }
 
 // A servo control that throws in its `at`-th call; counts the other arm's cycles it has seen.

@@ -4,8 +4,14 @@
 // program that took the time. No timing thresholds: the simulated clock gives exact cycles.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <map>
+#include <memory>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -24,10 +30,11 @@ struct Journal {
     char phase = 0;  // 'r', 'c', 'w'
     std::uint64_t cycle = 0;
     std::thread::id thread;
+    double time = 0;  // the cycle's clock time
   };
-  void add(int program, char phase, std::uint64_t cycle) noexcept {
+  void add(int program, char phase, std::uint64_t cycle, double time = 0) noexcept {
     const std::size_t i = size.fetch_add(1);
-    if (i < entries.size()) entries[i] = Entry{program, phase, cycle, std::this_thread::get_id()};
+    if (i < entries.size()) entries[i] = Entry{program, phase, cycle, std::this_thread::get_id(), time};
   }
   std::vector<Entry> entries;
   std::atomic<std::size_t> size{0};
@@ -332,6 +339,166 @@ TEST(Executor, AnOverrunIsNamedAfterTheProgramThatTookTheTime) {
   EXPECT_GE(hog.getStatistics().overruns, 1u);
   EXPECT_GE(idle.getStatistics().overruns, 1u);  // every program of the executor missed the deadline
   EXPECT_GE(hog.getStatistics().computationTime.max, idle.getStatistics().computationTime.max);
+}
+
+
+// A program started from inside a cycle of an executor while another program of the same executor
+// is being stopped from outside: stop() waits for the loop to let go of the list that still holds
+// the stopped program, and the loop's start() needs the executors' registry. Neither may wait for
+// the other while holding what the other needs (this hung before stop() waited outside the
+// registry's lock). A watchdog ends the process with a message if the scenario does not finish.
+class Notifier : public ControlProgram {
+ public:
+  explicit Notifier(const std::string& name) : ControlProgram(name) {}
+  ~Notifier() override { stop(); }
+  std::atomic<bool> exited{false};
+
+ protected:
+  void control() override {}
+  void exitControl() override { exited.store(true); }  // in the executor's thread, in the cycle that ends it
+};
+
+class Launcher : public ControlProgram {
+ public:
+  Launcher(const std::string& name, Notifier& victim, ControlProgram& late)
+      : ControlProgram(name), victim_(victim), late_(late) {}
+  ~Launcher() override { stop(); }
+  std::atomic<bool> launched{false};
+
+ protected:
+  void control() override {
+    if (launched.load() || !victim_.exited.load()) return;
+    // The victim ended at the start of this cycle; its stop() is now taking it out of the list and
+    // waits for this cycle to end. Give it time to get there, then start a program.
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    late_.start();
+    launched.store(true);
+  }
+
+ private:
+  Notifier& victim_;
+  ControlProgram& late_;
+};
+
+TEST(Executor, StartingAProgramInACycleWhileAnotherStopsDoesNotDeadlock) {
+  std::atomic<bool> done{false};
+  std::thread watchdog([&] {
+    for (int i = 0; i < 300 && !done.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (!done.load()) {
+      std::fprintf(stderr, "Executor deadlock: stop() and a start() from the loop wait for each other\n");
+      std::_Exit(3);
+    }
+  });
+  Notifier victim("victim"), late("late");
+  Launcher launcher("launcher", victim, late);
+  for (ControlProgram* p : {static_cast<ControlProgram*>(&victim), static_cast<ControlProgram*>(&late),
+                            static_cast<ControlProgram*>(&launcher)}) {
+    p->setClock(RealClock::instance());
+    p->setRate(250);
+    p->setPriority(12);  // an executor of its own among the tests' (rate and priority)
+  }
+  launcher.start();
+  victim.start();
+  while (launcher.getCycleCount() < 3) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  victim.stop();
+  while (!launcher.launched.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const std::uint64_t lateCycles = late.getCycleCount();
+  while (late.getCycleCount() < lateCycles + 3) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_EQ(executorsWith("late"), 1u);
+  EXPECT_EQ(executorsWith("victim"), 0u);
+  late.stop();
+  launcher.stop();
+  done.store(true);
+  watchdog.join();
+  EXPECT_FALSE(victim.isRunning());
+}
+
+
+// A spread executor (setExecutorCpus()): the programs of one rate are dealt to a thread on each
+// CPU in turn, and the threads meet between the phases: every read of a cycle comes before every
+// control of that cycle, every control before every write, and a control law reads another
+// thread's program's input of the same cycle.
+class Stamped : public ControlProgram {
+ public:
+  Stamped(const std::string& name, int id, Journal& journal) : ControlProgram(name), id_(id), journal_(journal) {}
+  ~Stamped() override { stop(); }
+  const Stamped* watch = nullptr;
+  std::atomic<double> measured{-1};  // the clock time of the cycle of its last read
+  std::atomic<long> compared{0}, mismatches{0};
+
+ protected:
+  void readInputs() override {
+    measured.store(getTime());
+    journal_.add(id_, 'r', getCycleCount(), getTime());
+  }
+  void control() override {
+    journal_.add(id_, 'c', getCycleCount(), getTime());
+    if (watch != nullptr && getCycleCount() >= 1 && watch->getCycleCount() >= 1) {
+      compared.fetch_add(1);
+      if (watch->measured.load() != getTime()) mismatches.fetch_add(1);
+    }
+  }
+  void writeOutputs() override { journal_.add(id_, 'w', getCycleCount(), getTime()); }
+
+ private:
+  int id_;
+  Journal& journal_;
+};
+
+TEST(Executor, ASpreadExecutorKeepsThePhasesAcrossItsThreads) {
+  EXPECT_THROW(ControlProgram::setExecutorCpus({1}), std::invalid_argument);
+  EXPECT_THROW(ControlProgram::setExecutorCpus({0, 0}), std::invalid_argument);
+  EXPECT_THROW(ControlProgram::setExecutorCpus({-1, 1}), std::invalid_argument);
+  ControlProgram::setExecutorCpus({0, 1});
+  EXPECT_EQ(ControlProgram::getExecutorCpus(), (std::vector<int>{0, 1}));
+  constexpr int kPrograms = 4, kCycles = 40;
+  Journal journal(kPrograms * 3 * kCycles);
+  std::vector<std::unique_ptr<Stamped>> programs;
+  for (int i = 0; i < kPrograms; ++i) {
+    programs.push_back(std::make_unique<Stamped>("spread" + std::to_string(i), i, journal));
+    programs.back()->setClock(RealClock::instance());
+    programs.back()->setRate(200);
+    programs.back()->setPriority(13);  // an executor of its own among the tests' (rate and priority)
+    programs.back()->setCycleLimit(kCycles);
+  }
+  programs[0]->watch = programs[1].get();  // stepped by the other thread
+  programs[3]->watch = programs[2].get();
+  for (auto& p : programs) p->start();
+  ControlProgram::setExecutorCpus({});  // for executors started later
+  bool found = false;
+  for (const auto& e : ControlProgram::getExecutorStatistics())
+    if (!e.programs.empty() && e.programs[0] == "spread0") {
+      found = true;
+      EXPECT_EQ(e.programs.size(), 4u);
+      EXPECT_EQ(e.cpus, (std::vector<int>{0, 1}));
+    }
+  EXPECT_TRUE(found);
+  for (auto& p : programs) p->waitUntilStopped();
+
+  const std::size_t n = journal.size.load();
+  ASSERT_EQ(n, static_cast<std::size_t>(kPrograms * 3 * kCycles));
+  // Each program in one thread; programs 0 and 2 in one, 1 and 3 in another.
+  std::vector<std::thread::id> thread(kPrograms);
+  for (std::size_t i = 0; i < n; ++i) thread[journal.entries[i].program] = journal.entries[i].thread;
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(journal.entries[i].thread, thread[journal.entries[i].program]) << i;
+  EXPECT_EQ(thread[0], thread[2]);
+  EXPECT_EQ(thread[1], thread[3]);
+  EXPECT_NE(thread[0], thread[1]);
+  // Within each cycle (one clock time), the phases in order across both threads.
+  std::map<double, std::string> phasesOfCycle;
+  for (std::size_t i = 0; i < n; ++i) phasesOfCycle[journal.entries[i].time] += journal.entries[i].phase;
+  for (const auto& [time, phases] : phasesOfCycle) {
+    std::string sorted = phases;
+    std::sort(sorted.begin(), sorted.end(), [](char a, char b) {
+      auto rank = [](char c) { return c == 'r' ? 0 : c == 'c' ? 1 : 2; };
+      return rank(a) < rank(b);
+    });
+    EXPECT_EQ(phases, sorted) << "cycle at " << time;
+  }
+  for (int i : {0, 3}) {
+    EXPECT_GE(programs[i]->compared.load(), kCycles - 2);
+    EXPECT_EQ(programs[i]->mismatches.load(), 0) << "program " << i;
+  }
 }
 
 }  // namespace

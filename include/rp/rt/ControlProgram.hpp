@@ -54,6 +54,7 @@ struct ExecutorStatistics {
   double rate = 0;                   ///< loop rate [Hz]
   int priority = 0;                  ///< SCHED_FIFO priority
   int cpu = -1;                      ///< CPU it is pinned to, or -1
+  std::vector<int> cpus;             ///< the CPUs of its threads when spread (setExecutorCpus()), else empty
   bool ownThread = false;            ///< a program's thread of its own (ThreadMode::Own)
   bool simulatedClock = false;       ///< runs on a simulated clock
   bool realTimeScheduling = false;   ///< the thread runs with SCHED_FIFO
@@ -201,6 +202,19 @@ class ControlProgram {
   static void setDefaultThreadMode(ThreadMode mode);
   /// The thread mode of programs constructed from now on.
   static ThreadMode getDefaultThreadMode();
+  /// Spreads the shared executors started from now on over several CPUs, for more programs of one
+  /// rate than one core can step: an executor on the real clock whose programs have no CPU of
+  /// their own (setCpuAffinity()) runs a thread pinned to each CPU of the list, the first one its
+  /// loop; the programs are dealt to the threads in turn in the order they joined (program i to
+  /// thread i mod the number of CPUs), and the threads meet after each phase, so the phases and
+  /// the same-cycle guarantee hold across them. An empty list (the default, unless the environment
+  /// variable `RP_EXECUTOR_CPUS` lists CPUs, e.g. `0,1`) keeps one thread per executor. Executors
+  /// already running keep their threads; simulated clocks always step an executor in one thread.
+  /// @param[in] cpus  two or more distinct CPU numbers, or none
+  /// @throws std::invalid_argument for one CPU, a CPU out of range or a CPU listed twice
+  static void setExecutorCpus(const std::vector<int>& cpus);
+  /// The CPUs shared executors started from now on spread over (empty: one thread each).
+  static std::vector<int> getExecutorCpus();
   /// @}
 
   /// @name Running
