@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../model/ExportFrames.hpp"
+#include "../rt/CycleSignal.hpp"
 #include "geometry_msgs.h"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/TypeDatabase.hpp"
@@ -23,6 +25,8 @@
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/ManipulatorData.hpp"
 #include "rp/model/UrdfExport.hpp"
+#include "rp/rt/Clock.hpp"
+#include "rp/rt/ControlProgram.hpp"
 #include "sensor_msgs.h"
 #include "std_msgs.h"
 #include "tf2_msgs.h"
@@ -98,6 +102,22 @@ builtin_interfaces_msg_dds__Time_ now() {
   return t;
 }
 
+// The wall-clock time of the servo cycle that took a snapshot at clock time `cycleTime`: on the
+// real clock, the time of publication minus the snapshot's age; on a simulated clock (whose time
+// is not the wall's) the time of publication.
+builtin_interfaces_msg_dds__Time_ cycleStamp(Manipulator& m, double cycleTime, const builtin_interfaces_msg_dds__Time_& publishedAt) {
+  const ControlProgram* program = m.getControlProgram();
+  if (program == nullptr || program->getClock().isSimulated()) return publishedAt;
+  const double age = program->getClock().getTime() - cycleTime;
+  if (!(age >= 0 && age < 1)) return publishedAt;
+  const std::int64_t ns = static_cast<std::int64_t>(publishedAt.sec) * 1000000000LL + publishedAt.nanosec -
+                          static_cast<std::int64_t>(age * 1e9);
+  builtin_interfaces_msg_dds__Time_ t{};
+  t.sec = static_cast<int32_t>(ns / 1000000000LL);
+  t.nanosec = static_cast<uint32_t>(ns % 1000000000LL);
+  return t;
+}
+
 // Quaternion (x, y, z, w) of a rotation matrix, w >= 0.
 void toQuaternion(const Transform& t, geometry_msgs_msg_dds__Quaternion_& q) {
   const Eigen::Matrix3d R = t.topLeftCorner<3, 3>();
@@ -126,6 +146,7 @@ struct ArmEntry {
   std::string lastState;
   std::chrono::steady_clock::time_point lastStateTime;
   bool seen = false;
+  double lastTime = std::numeric_limits<double>::quiet_NaN();  // the servo cycle (its time) published last
   dds_entity_t trajectoryReader = 0;
   std::unique_ptr<TimedTrajectoryGenerator> generator;  // connected to the arm on the first trajectory taken
   std::string lastCommand;  // the message about the last trajectory (accepted or refused)
@@ -141,6 +162,7 @@ struct Ros2Bridge::Impl {
   std::map<std::string, dds_entity_t> topics;
   dds_entity_t jointStates = 0, tf = 0, tfStatic = 0, description = 0;
   std::map<const RoboticObject*, ArmEntry> arms;
+  std::chrono::steady_clock::time_point lastFull{};  // the last full cycle (see cycle())
   std::atomic<std::uint64_t> cycles{0}, jointStatesWritten{0}, tfWritten{0}, descriptions{0}, states{0}, failures{0};
   std::atomic<std::size_t> manipulators{0};
   std::atomic<std::uint64_t> trajectories{0}, trajectoriesRefused{0};
@@ -203,6 +225,9 @@ struct Ros2Bridge::Impl {
   void addArm(const RoboticObject* o, Manipulator& m, ArmEntry& e);
   void takeTrajectories(Manipulator& m, ArmEntry& e);
   std::string executeTrajectory(Manipulator& m, ArmEntry& e, const trajectory_msgs_msg_dds__JointTrajectory_& msg);
+  void writeSample(const ManipulatorModel& model, ArmEntry& e, const JointVector& q, const JointVector& qd,
+                   const JointVector& tau, const builtin_interfaces_msg_dds__Time_& stamp,
+                   std::vector<geometry_msgs_msg_dds__TransformStamped_>& transforms);
   void cycle();
   void publishCombinedDescription();
 };
@@ -224,8 +249,16 @@ Ros2Bridge::Ros2Bridge(const std::string& name) : FunctionalObject(ClassSection(
                                    "digits, '_' and '/', each part starting with a letter or '_')");
     }
     if (const ConfigSetting* s = section->find("rate")) {
-      const double r = section->getNumbers("rate").at(0);
-      if (!(r >= 1 && r <= 1000)) throw section->errorAt(*s, "setting 'rate' must be 1 .. 1000 Hz");
+      const std::string word = section->getWord("rate");
+      double r = -1;
+      if (word == "servo") {
+        r = Ros2BridgeOptions::kServoRate;
+      } else {
+        char* end = nullptr;
+        r = std::strtod(word.c_str(), &end);
+        if (end == word.c_str() || *end != '\0' || !(r >= 1 && r <= 1000)) r = -1;
+      }
+      if (r < 0) throw section->errorAt(*s, "setting 'rate' must be servo or 1 .. 1000 Hz, got '" + word + "'");
       o.rate = r;
     }
     if (const ConfigSetting* s = section->find("interfaces")) {
@@ -264,7 +297,8 @@ Ros2Bridge::~Ros2Bridge() {
 std::string Ros2Bridge::checkOptions(const Ros2BridgeOptions& o) {
   if (o.domain < 0 || o.domain > kMaxDomain) return "domain must be 0 .. " + std::to_string(kMaxDomain);
   if (!validNamespace(o.nameSpace)) return "namespace '" + o.nameSpace + "' is not a ROS namespace";
-  if (!(o.rate >= 1 && o.rate <= 1000)) return "rate must be 1 .. 1000 Hz";
+  if (!(o.rate == Ros2BridgeOptions::kServoRate || (o.rate >= 1 && o.rate <= 1000)))
+    return "rate must be Ros2BridgeOptions::kServoRate or 1 .. 1000 Hz";
   if (o.interfaces.empty()) return "interfaces must name at least one interface";
   for (const std::string& v : o.interfaces)
     if (!validInterface(v)) return "'" + v + "' is not an interface name or address";
@@ -275,7 +309,7 @@ void Ros2Bridge::declareSettings(SettingSchema& schema) {
   RoboticObject::declareSettings(schema);
   schema.addInteger("domain", "DDS domain id (ROS_DOMAIN_ID)", 0, kMaxDomain);
   schema.addWord("namespace", "ROS namespace of the topics, e.g. cell1");
-  schema.addNumbers("rate", 1, "Hz", "joint_states and tf samples per second", 1, 1000);
+  schema.addWord("rate", "joint_states and tf samples per second, 1 .. 1000 Hz, or servo: every servo cycle");
   SettingSpec interfaces;
   interfaces.name = "interfaces";
   interfaces.kind = SettingKind::Word;
@@ -403,7 +437,18 @@ void Ros2Bridge::start() {
   d.tf = d.writer(tf2_msgs_msg_dds__TFMessage__desc, "tf", false);
   d.tfStatic = d.writer(tf2_msgs_msg_dds__TFMessage__desc, "tf_static", true);
   d.description = d.writer(std_msgs_msg_dds__String__desc, "robot_description", true);
-  addPeriodicThread("ros2bridge", 1.0 / d.options.rate, [this] { impl_->cycle(); });
+  if (d.options.rate == Ros2BridgeOptions::kServoRate) {
+    // Every servo cycle: woken as executor cycles end (CycleSignal), or every 50 ms without any.
+    addThread("ros2bridge", [this](const std::atomic<bool>& stop) {
+      std::uint64_t seen = internal::cyclesEnded();
+      while (!stop.load(std::memory_order_acquire)) {
+        seen = internal::waitForCycleEnd(seen, 0.05);
+        impl_->cycle();
+      }
+    });
+  } else {
+    addPeriodicThread("ros2bridge", 1.0 / d.options.rate, [this] { impl_->cycle(); });
+  }
 }
 
 void Ros2Bridge::Impl::addArm(const RoboticObject* o, Manipulator& m, ArmEntry& e) {
@@ -461,12 +506,50 @@ void Ros2Bridge::Impl::publishCombinedDescription() {
   writeString(description, all, descriptions);
 }
 
+// One arm's sample: its joint_states message, and its frames added to this cycle's tf message.
+void Ros2Bridge::Impl::writeSample(const ManipulatorModel& model, ArmEntry& e, const JointVector& q, const JointVector& qd,
+                                   const JointVector& tau, const builtin_interfaces_msg_dds__Time_& stamp,
+                                   std::vector<geometry_msgs_msg_dds__TransformStamped_>& transforms) {
+  const int n = model.getNumberOfJoints();
+  std::vector<char*> names(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) names[static_cast<std::size_t>(i)] = const_cast<char*>(e.jointNames[static_cast<std::size_t>(i)].c_str());
+  sensor_msgs_msg_dds__JointState_ js{};
+  js.header.stamp = stamp;
+  js.header.frame_id = const_cast<char*>("");
+  js.name._buffer = names.data();
+  js.position._buffer = const_cast<double*>(q.data());  // dds_write only reads
+  js.velocity._buffer = const_cast<double*>(qd.data());
+  js.effort._buffer = const_cast<double*>(tau.data());
+  for (auto* s : {&js.position, &js.velocity, &js.effort}) s->_length = s->_maximum = static_cast<uint32_t>(n);
+  js.name._length = js.name._maximum = static_cast<uint32_t>(n);
+  write(jointStates, &js, jointStatesWritten);
+
+  forwardKinematics(model, *e.data, q);
+  for (std::size_t f = 0; f < e.frameNames.size(); ++f) {
+    const Transform t = (f < static_cast<std::size_t>(n) ? e.data->linkTransforms[f] : e.data->endEffector) * e.frameFromModel[f];
+    geometry_msgs_msg_dds__TransformStamped_ ts{};
+    ts.header.stamp = stamp;
+    ts.header.frame_id = const_cast<char*>("world");
+    ts.child_frame_id = const_cast<char*>(e.frameNames[f].c_str());
+    ts.transform.translation = {t(0, 3), t(1, 3), t(2, 3)};
+    toQuaternion(t, ts.transform.rotation);
+    transforms.push_back(ts);
+  }
+}
+
 void Ros2Bridge::Impl::cycle() {
   ++cycles;
+  // At the servo rate this runs after every servo cycle: the arms' state, trajectories taken,
+  // arms joined and gone are looked at 50 times a second ("full" cycles), as at a set rate always.
+  const bool servo = options.rate == Ros2BridgeOptions::kServoRate;
+  const auto started = std::chrono::steady_clock::now();
+  const bool full = !servo || started - lastFull >= std::chrono::milliseconds(20);
+  if (full) lastFull = started;
   std::vector<ObjectReference> published = ObjectManager().getPublishedObjects();
-  for (auto& [o, e] : arms) e.seen = false;
+  if (full)
+    for (auto& [o, e] : arms) e.seen = false;
   bool changed = false;
-  const builtin_interfaces_msg_dds__Time_ stamp = now();
+  const builtin_interfaces_msg_dds__Time_ publishedAt = now();
   std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms;
   std::vector<std::string> frameIds;  // keeps the child frame names alive
   std::size_t count = 0;
@@ -474,6 +557,7 @@ void Ros2Bridge::Impl::cycle() {
     auto* m = dynamic_cast<Manipulator*>(r.get());
     if (!m) continue;
     auto it = arms.find(r.get());
+    if (!full && (it == arms.end() || it->second.name != m->getName())) continue;  // joins in a full cycle
     if (it == arms.end() || it->second.name != m->getName()) {
       if (it != arms.end()) {  // a new arm at the address of a destroyed one
         dds_delete(it->second.stateWriter);
@@ -494,45 +578,26 @@ void Ros2Bridge::Impl::cycle() {
     StateSnapshot snap;
     JointVector q(n), qd(n), tau(n);
     bool power = m->isArmPowerOn();
+    builtin_interfaces_msg_dds__Time_ stamp = publishedAt;
+    bool fresh = true;  // a sample to write (at the servo rate: only of a servo cycle not yet written)
     if (m->getStateSnapshot(snap) && snap.size >= 3 * n + 1) {
+      fresh = !servo || snap.time != e.lastTime;
+      e.lastTime = snap.time;
       for (int i = 0; i < n; ++i) {
         q(i) = snap.values[i];
         qd(i) = snap.values[n + i];
         tau(i) = snap.values[2 * n + i];
       }
       power = snap.values[3 * n] != 0;
+      stamp = cycleStamp(*m, snap.time, publishedAt);
     } else {
       q = m->getJointPosition();
       qd = m->getJointVelocity();
       tau = m->getControlOutput();
     }
     if (q.size() != n || qd.size() != n || tau.size() != n) continue;
-
-    std::vector<char*> names(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) names[static_cast<std::size_t>(i)] = const_cast<char*>(e.jointNames[static_cast<std::size_t>(i)].c_str());
-    sensor_msgs_msg_dds__JointState_ js{};
-    js.header.stamp = stamp;
-    js.header.frame_id = const_cast<char*>("");
-    js.name._buffer = names.data();
-    js.position._buffer = q.data();
-    js.velocity._buffer = qd.data();
-    js.effort._buffer = tau.data();
-    for (auto* s : {&js.position, &js.velocity, &js.effort}) s->_length = s->_maximum = static_cast<uint32_t>(n);
-    js.name._length = js.name._maximum = static_cast<uint32_t>(n);
-    write(jointStates, &js, jointStatesWritten);
-
-    forwardKinematics(model, *e.data, q);
-    for (std::size_t f = 0; f < e.frameNames.size(); ++f) {
-      const Transform t = (f < static_cast<std::size_t>(n) ? e.data->linkTransforms[f] : e.data->endEffector) * e.frameFromModel[f];
-      geometry_msgs_msg_dds__TransformStamped_ ts{};
-      ts.header.stamp = stamp;
-      ts.header.frame_id = const_cast<char*>("world");
-      ts.child_frame_id = const_cast<char*>(e.frameNames[f].c_str());
-      ts.transform.translation = {t(0, 3), t(1, 3), t(2, 3)};
-      toQuaternion(t, ts.transform.rotation);
-      transforms.push_back(ts);
-    }
-
+    if (fresh) writeSample(model, e, q, qd, tau, stamp, transforms);
+    if (!full) continue;
     takeTrajectories(*m, e);
 
     // Diagnostics: when they change and once a second.
@@ -563,7 +628,7 @@ void Ros2Bridge::Impl::cycle() {
     msg.transforms._length = msg.transforms._maximum = static_cast<uint32_t>(transforms.size());
     write(tf, &msg, tfWritten);
   }
-  for (auto it = arms.begin(); it != arms.end();) {  // arms destroyed since: their writers go
+  for (auto it = arms.begin(); full && it != arms.end();) {  // arms destroyed since: their writers go
     if (!it->second.seen) {
       dds_delete(it->second.stateWriter);
       dds_delete(it->second.descriptionWriter);

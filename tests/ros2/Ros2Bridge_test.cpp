@@ -6,6 +6,9 @@
 
 #include <dds/dds.h>
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
@@ -53,10 +56,15 @@ TEST_F(Ros2BridgeTest, DdsNamesFollowRos2Conventions) {
   bad = {};
   bad.nameSpace = "9lives";
   EXPECT_TRUE(contains(Ros2Bridge::checkOptions(bad), "namespace"));
-  bad = {};
-  bad.rate = 0;
-  EXPECT_TRUE(contains(Ros2Bridge::checkOptions(bad), "rate"));
-  EXPECT_THROW(Ros2Bridge("b", bad), std::invalid_argument);
+  for (const double rate : {-1.0, 0.5, 1001.0}) {
+    bad = {};
+    bad.rate = rate;
+    EXPECT_TRUE(contains(Ros2Bridge::checkOptions(bad), "rate")) << rate;
+    EXPECT_THROW(Ros2Bridge("b", bad), std::invalid_argument) << rate;
+  }
+  Ros2BridgeOptions servo;
+  servo.rate = Ros2BridgeOptions::kServoRate;
+  EXPECT_EQ(Ros2Bridge::checkOptions(servo), "");
 }
 
 TEST_F(Ros2BridgeTest, PublishesTheArmsJointStatesWithRos2NamesAndTypes) {
@@ -301,6 +309,8 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
       {"namespace a//b", "namespace"},
       {"rate 0", "rate"},
       {"rate 5000", "rate"},
+      {"rate fast", "rate"},
+      {"rate 50Hz", "rate"},
       {"interfaces no$such", "interfaces"},
       {"interfaces rpnosuchif0", "interfaces"},
       {"commands maybe", "commands"},
@@ -330,6 +340,48 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
   bridge->setCommandsEnabled(false);
   EXPECT_FALSE(bridge->areCommandsEnabled());
   EXPECT_FALSE(Ros2BridgeOptions{}.commands) << "commands are off by default";
+  ObjectManager().deleteAllObjects();
+  configure("[ros]\nclass Ros2Bridge\ndomain " + std::to_string(options_.domain) + "\nrate servo\n");
+  auto* servo = ObjectManager().createDerivedObject<Ros2Bridge>("ros");
+  ASSERT_NE(servo, nullptr);
+  EXPECT_EQ(servo->getOptions().rate, Ros2BridgeOptions::kServoRate);
+}
+
+// At the servo rate (`rate servo`) the bridge publishes every servo cycle as it ends: each sample
+// is a cycle not published before, stamped with that cycle's time, so the stamps are whole servo
+// periods apart and most are one period apart (at a set rate of 100 Hz they are ten).
+TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithItsTime) {
+  Puma560 puma("puma");
+  options_.rate = Ros2BridgeOptions::kServoRate;
+  Ros2Bridge bridge("ros", options_);
+  const dds_entity_t r = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
+  std::vector<double> stamps;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (stamps.size() < 400 && std::chrono::steady_clock::now() < end) {
+    void* samples[10] = {nullptr};
+    dds_sample_info_t info[10];
+    const dds_return_t n = dds_take(r, samples, info, 10, 10);
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (!info[i].valid_data) continue;
+      const auto& m = *static_cast<const sensor_msgs_msg_dds__JointState_*>(samples[i]);
+      stamps.push_back(static_cast<double>(m.header.stamp.sec) + 1e-9 * static_cast<double>(m.header.stamp.nanosec));
+    }
+    if (n > 0) dds_return_loan(r, samples, n);
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  ASSERT_GE(stamps.size(), 400u);
+  const double period = 1.0 / puma.getControlProgram()->getRate();
+  std::vector<double> gaps;
+  // From the second sample on: the first may be the arm's state from before its first cycle,
+  // stamped when it was published.
+  for (std::size_t k = 2; k < stamps.size(); ++k) {
+    const double periods = (stamps[k] - stamps[k - 1]) / period;
+    EXPECT_GE(periods, 0.95) << "sample " << k << ": not a later cycle";
+    EXPECT_NEAR(periods, std::round(periods), 0.05) << "sample " << k << ": not a cycle's time";
+    gaps.push_back(periods);
+  }
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+  EXPECT_NEAR(gaps[gaps.size() / 2], 1.0, 0.05) << "the median sample is not the next servo cycle";
 }
 
 }  // namespace

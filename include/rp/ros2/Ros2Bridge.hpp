@@ -19,7 +19,10 @@ struct Ros2BridgeOptions {
   /// ROS namespace of every topic, e.g. `cell1` or `/lab/cell1` (empty: none); letters, digits,
   /// `_` and `/`, each part starting with a letter or `_`.
   std::string nameSpace;
-  double rate = 50;        ///< joint_states and tf samples per second [Hz], 1..1000
+  /// joint_states and tf samples per second [Hz], 1..1000, or kServoRate: every servo cycle of
+  /// each arm, published as that cycle ends (rp.cfg `rate servo`)
+  double rate = 50;
+  static constexpr double kServoRate = 0;  ///< `rate`: every servo cycle, as it ends
   /// Network interfaces DDS may use (Linux names such as `eth0`, or IPv4 addresses); `{"lo"}`
   /// (the default) keeps DDS on this machine; `{"any"}` lets Cyclone DDS choose.
   std::vector<std::string> interfaces{"lo"};
@@ -63,14 +66,19 @@ struct Ros2BridgeStatistics {
 ///
 /// The bridge's own thread samples the arms `rate` times a second from the snapshots their servo
 /// threads publish (as the Scene Viewer does): a servo loop never waits for the bridge or the
-/// network. Arms created after the bridge are published from the next cycle on.
+/// network. With `rate servo` (Ros2BridgeOptions::kServoRate) the thread wakes whenever a servo
+/// cycle ends (an executor's cycle, through a futex the loop only signals) and publishes each arm
+/// whose snapshot is new: every servo cycle of every arm, as soon as it ends; the state topics and
+/// the trajectories taken are then looked at 50 times a second. Stamps are the wall-clock time of
+/// the servo cycle that read the joints (on the real clock; on a simulated clock, the time of
+/// publication). Arms created after the bridge are published from the next cycle on.
 ///
 /// rp.cfg (`[ros]` + `class Ros2Bridge`):
 /// | setting | meaning |
 /// |---|---|
 /// | `domain D` | DDS domain id 0..230 (default 0) |
 /// | `namespace NS` | ROS namespace of the topics (default none) |
-/// | `rate HZ` | joint_states and tf rate 1..1000 Hz (default 50) |
+/// | `rate HZ\|servo` | joint_states and tf rate 1..1000 Hz, or every servo cycle (default 50) |
 /// | `interfaces IF...` | network interfaces for DDS (default `lo`: this machine only; `any`: Cyclone's choice) |
 /// | `commands on\|off` | take trajectories from `<object>/joint_trajectory` (default off) |
 class Ros2Bridge : public FunctionalObject {
