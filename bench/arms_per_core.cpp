@@ -25,9 +25,13 @@
 //
 // Each mode's result line begins `arms_per_core MODE N ...`.
 //
+// --mode spread (not part of `both`): one executor spread over CPUs 0 and 1
+// (ControlProgram::setExecutorCpus()), the process not pinned: arms per two cores, in one cycle.
+//
 // --integrator rk4|euler (default rk4, the simulation's default) chooses how each simulated arm
 // integrates its dynamics (rp.cfg's `integrator`, written for the arms into a configuration file
-// in /tmp): RK4 takes four forward-dynamics evaluations per step, semi-implicit Euler one.
+// in /tmp as the section of class Puma560): RK4 takes four forward-dynamics evaluations per step,
+// semi-implicit Euler one.
 //
 // Usage: arms_per_core [--mode M] [--integrator I] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
 #include <sched.h>
@@ -171,8 +175,8 @@ int main(int argc, char** argv) {
     };
     if (a == "--mode") {
       mode = value();
-      if (mode != "shared" && mode != "own" && mode != "both") {
-        std::fprintf(stderr, "arms_per_core: --mode must be shared, own or both\n");
+      if (mode != "shared" && mode != "own" && mode != "both" && mode != "spread") {
+        std::fprintf(stderr, "arms_per_core: --mode must be shared, own, both or spread\n");
         return 2;
       }
     } else if (a == "--integrator") {
@@ -195,7 +199,7 @@ int main(int argc, char** argv) {
       resolution = std::max(1, std::atoi(value()));
     } else {
       std::fprintf(stderr,
-                   "usage: arms_per_core [--mode shared|own|both] [--integrator rk4|euler] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
+                   "usage: arms_per_core [--mode shared|own|both|spread] [--integrator rk4|euler] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
       return 2;
     }
   }
@@ -211,10 +215,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   RoboticPlatform::setSimulationModeOn();  // real clock (the default), simulated arms
-  // The arms' sections: arm0 ... arm<max-1>, each a Puma 560 with the chosen integrator.
+  // The arms' class section: every Puma 560 without a section of its own (arm0, arm1, ...) takes
+  // the chosen integrator from it.
   const std::string config = "/tmp/arms_per_core_" + std::to_string(getpid()) + ".cfg";
   if (FILE* f = std::fopen(config.c_str(), "w")) {
-    for (int i = 0; i < max; ++i) std::fprintf(f, "[arm%d]\nclass Puma560\nintegrator %s\n\n", i, integrator.c_str());
+    std::fprintf(f, "[Puma560]\nclass Puma560\nintegrator %s\n", integrator.c_str());
     std::fclose(f);
   } else {
     std::fprintf(stderr, "arms_per_core: cannot write %s: %s\n", config.c_str(), std::strerror(errno));
@@ -226,10 +231,25 @@ int main(int argc, char** argv) {
   std::vector<std::string> modes;
   if (mode == "both" || mode == "shared") modes.push_back("shared");
   if (mode == "both" || mode == "own") modes.push_back("own");
+  if (mode == "spread") {
+    modes.push_back("spread");
+    CPU_ZERO(&set);
+    CPU_SET(0, &set);
+    CPU_SET(1, &set);
+    if (sched_setaffinity(0, sizeof set, &set) != 0) {
+      std::fprintf(stderr, "arms_per_core: cannot use CPUs 0 and 1: %s\n", std::strerror(errno));
+      return 1;
+    }
+    ControlProgram::setExecutorCpus({0, 1});
+  }
   for (const std::string& m : modes) {
-    ControlProgram::setDefaultThreadMode(m == "own" ? ThreadMode::Own : ThreadMode::Shared);
-    std::printf("mode %s: simulated Puma 560 arms (integrator %s) at 1 kHz on CPU %d, %.1f s per trial\n", m.c_str(),
-                integrator.c_str(), cpu, seconds);
+    ControlProgram::setDefaultThreadMode(m == "own" ? ThreadMode::Own : ThreadMode::Shared);  // spread: shared
+    if (m == "spread")
+      std::printf("mode spread: simulated Puma 560 arms (integrator %s) at 1 kHz, one executor on CPUs 0 and 1, %.1f s per trial\n",
+                  integrator.c_str(), seconds);
+    else
+      std::printf("mode %s: simulated Puma 560 arms (integrator %s) at 1 kHz on CPU %d, %.1f s per trial\n", m.c_str(),
+                  integrator.c_str(), cpu, seconds);
     Trial best;
     int bad = 0;
     for (int n = start; n <= max; n *= 2) {

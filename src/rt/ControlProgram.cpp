@@ -645,35 +645,29 @@ struct ControlProgram::Executor {
       barrier.wait();
       last = internal::monotonicNanoseconds();
     };
+    // Each phase: this thread's programs in their order, each one's time charged to it.
+    auto each = [&](auto&& phase) {
+      for (std::size_t i = first; i < l.size(); i += stride) {
+        Impl* p = l[i];
+        if (!active(p)) continue;
+        internal::currentLoop = p;
+        phase(*p);
+        charge(p);
+      }
+    };
     // Phase 1: parameters and inputs.
-    for (std::size_t i = first; i < l.size(); i += stride) {
-      Impl* p = l[i];
-      if (!active(p)) continue;
-      internal::currentLoop = p;
-      p->cycleNs = 0;
-      p->time.store(cycleClock, std::memory_order_relaxed);
-      p->applyParameters();
-      p->self.readInputs();
-      charge(p);
-    }
+    each([&](Impl& p) {
+      p.cycleNs = 0;
+      p.time.store(cycleClock, std::memory_order_relaxed);
+      p.applyParameters();
+      p.self.readInputs();
+    });
     meet();
     // Phase 2: control laws, each seeing every program's inputs of this cycle.
-    for (std::size_t i = first; i < l.size(); i += stride) {
-      Impl* p = l[i];
-      if (!active(p)) continue;
-      internal::currentLoop = p;
-      p->self.control();
-      charge(p);
-    }
+    each([](Impl& p) { p.self.control(); });
     meet();
     // Phase 3: outputs.
-    for (std::size_t i = first; i < l.size(); i += stride) {
-      Impl* p = l[i];
-      if (!active(p)) continue;
-      internal::currentLoop = p;
-      p->self.writeOutputs();
-      charge(p);
-    }
+    each([](Impl& p) { p.self.writeOutputs(); });
     meet();
     internal::currentLoop = nullptr;
     return last;

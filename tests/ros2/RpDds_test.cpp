@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <string>
 
+#include "RunProgram.hpp"
 #include "rp/RoboticPlatform.hpp"
 
 namespace rp {
@@ -15,15 +16,7 @@ namespace {
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // Runs rp-dds with `args`; its output (stdout and stderr) and exit status.
-std::pair<std::string, int> rpDds(const std::string& args) {
-  FILE* p = popen((std::string(RP_DDS_PATH) + std::string(" ") + args + " 2>&1").c_str(), "r");
-  if (!p) return {"popen failed", -1};
-  std::string out;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, p)) out += buffer;
-  const int status = pclose(p);
-  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-}
+std::pair<std::string, int> rpDds(const std::string& args) { return test::runMerged(std::string(RP_DDS_PATH) + " " + args); }
 
 class RpDdsTest : public ::testing::Test {
  protected:

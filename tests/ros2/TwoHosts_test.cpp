@@ -11,27 +11,20 @@
 #include <cstdlib>
 #include <string>
 
+#include "RunProgram.hpp"
+
 namespace {
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-// Runs `command` through the shell; its output (stdout and stderr) and exit status.
-std::pair<std::string, int> run(const std::string& command) {
-  FILE* p = popen((command + " 2>&1").c_str(), "r");
-  if (!p) return {"popen failed", -1};
-  std::string out;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, p)) out += buffer;
-  const int status = pclose(p);
-  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-}
+using rp::test::runMerged;
 
 class TwoHosts : public ::testing::Test {
  protected:
   void SetUp() override {
     const std::string id = std::to_string(getpid());
     a_ = "rpA" + id, b_ = "rpB" + id, ifA_ = "rpvA" + id, ifB_ = "rpvB" + id;
-    const auto [out, status] = run("ip netns add " + a_);
+    const auto [out, status] = runMerged("ip netns add " + a_);
     if (status != 0) {
       skip_ = "cannot make a network namespace (`ip netns add` needs CAP_NET_ADMIN): " + out;
       return;
@@ -42,7 +35,7 @@ class TwoHosts : public ::testing::Test {
           "ip -n " + a_ + " addr add 10.213.0.1/24 dev " + ifA_, "ip -n " + b_ + " addr add 10.213.0.2/24 dev " + ifB_,
           "ip -n " + a_ + " link set lo up", "ip -n " + b_ + " link set lo up", "ip -n " + a_ + " link set " + ifA_ + " up",
           "ip -n " + b_ + " link set " + ifB_ + " up"}) {
-      const auto [o, s] = run(c);
+      const auto [o, s] = runMerged(c);
       ASSERT_EQ(s, 0) << c << ": " << o;
     }
     domain_ = std::to_string(1 + getpid() % 200);
@@ -50,12 +43,12 @@ class TwoHosts : public ::testing::Test {
   }
   void TearDown() override {
     if (!made_) return;
-    run("ip netns del " + a_);  // takes its end of the pair, and so the pair, with it
-    run("ip netns del " + b_);
+    runMerged("ip netns del " + a_);  // takes its end of the pair, and so the pair, with it
+    runMerged("ip netns del " + b_);
   }
   // rp-dds in namespace b_ with `args`.
   std::pair<std::string, int> rpDdsInB(const std::string& args) {
-    return run("ip netns exec " + b_ + " " + RP_DDS_PATH + " " + args + " -domain " + domain_);
+    return runMerged("ip netns exec " + b_ + " " + RP_DDS_PATH + " " + args + " -domain " + domain_);
   }
   std::string skip_;
   bool made_ = false;
@@ -89,7 +82,7 @@ TEST_F(TwoHosts, AReaderOnTheOtherHostGetsTheArmOverTheLinkOnly) {
 TEST_F(TwoHosts, ABridgeOnAnInterfaceItsHostLacksIsAnErrorNamingIt) {
   if (!skip_.empty()) GTEST_SKIP() << skip_;
   // ifB_ is in the other namespace: the arm's host has no such interface.
-  const auto [out, status] = run("ip netns exec " + a_ + " " + RP_ROS2_ARM_PATH + " " + domain_ + " " + ns_ + " " + ifB_ + " 1");
+  const auto [out, status] = runMerged("ip netns exec " + a_ + " " + RP_ROS2_ARM_PATH + " " + domain_ + " " + ns_ + " " + ifB_ + " 1");
   EXPECT_EQ(status, 1) << out;
   EXPECT_TRUE(contains(out, ifB_)) << out;
 }

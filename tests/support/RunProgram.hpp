@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 namespace rp::test {
 
@@ -38,6 +39,18 @@ inline Outcome runProgram(const std::string& command, const std::string& base) {
   std::remove((base + ".out").c_str());
   std::remove((base + ".err").c_str());
   return r;
+}
+
+// Runs `command` (a shell command line) and returns what it printed (stdout and stderr merged,
+// in order) and its exit status (-1 if it did not exit).
+inline std::pair<std::string, int> runMerged(const std::string& command) {
+  FILE* p = popen((command + " 2>&1").c_str(), "r");
+  if (!p) return {"popen failed", -1};
+  std::string out;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, p)) out += buffer;
+  const int status = pclose(p);
+  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
 }
 
 }  // namespace rp::test
