@@ -327,7 +327,8 @@ std::string RemoteManipulator::checkOptions(const RemoteManipulatorOptions& o) {
   const std::size_t slash = o.remote.rfind('/');
   const std::string object = slash == std::string::npos ? o.remote : o.remote.substr(slash + 1);
   const std::string ns = slash == std::string::npos ? "" : o.remote.substr(0, slash);
-  if (o.remote.empty() || object.empty() || !ros2detail::validNamespace(ns) || ros2detail::rosName(object) != object)
+  if (o.remote.empty() || object.empty() || !ros2detail::validNamespace(ns) || (!ns.empty() && ns.back() == '/') ||
+      ros2detail::rosName(object) != object)
     return "remote '" + o.remote + "' is not NS/OBJECT (a ROS namespace, then the arm's object name)";
   if (o.domain < 0 || o.domain > ros2detail::kMaxDomain) return "domain must be 0 .. " + std::to_string(ros2detail::kMaxDomain);
   if (o.interfaces.empty()) return "interfaces must name at least one interface";

@@ -256,6 +256,7 @@ TEST_F(RemoteManipulatorTest, SettingsErrorsNameTheFileAndLine) {
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     EXPECT_TRUE(contains(e.what(), "test.cfg:3")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "is not NS/OBJECT")) << e.what();
   }
   // Nobody there: the description is waited for a bounded time, and the error names its topic.
   configure("[leader]\nclass RemoteManipulator\nremote " + ns_ + "/nobody\ndomain " + std::to_string(options_.domain) +
