@@ -342,7 +342,7 @@ std::string RemoteManipulator::checkOptions(const RemoteManipulatorOptions& o) {
 
 void RemoteManipulator::declareSettings(SettingSchema& schema) {
   RoboticObject::declareSettings(schema);
-  schema.addWord("remote", "the remote arm: the remote Ros2Bridge's namespace / the arm's object name, e.g. cell1/puma");
+  schema.addWord("remote", "required: the remote arm, the remote Ros2Bridge's namespace / the arm's object name, e.g. cell1/puma");
   schema.addInteger("domain", "DDS domain id (ROS_DOMAIN_ID) of the remote bridge", 0, ros2detail::kMaxDomain);
   SettingSpec interfaces;
   interfaces.name = "interfaces";
