@@ -195,14 +195,20 @@ TEST_F(RemoteManipulatorTest, FigureTwentyOneMotionsEndWhereTheLocalArmEnds) {
 TEST_F(RemoteManipulatorTest, AVanishedRemoteArmEndsTheProgramWithAnError) {
   auto arm = startArm();
   const pid_t pid = arm->pid;
-  std::thread killer([pid] {
-    std::this_thread::sleep_for(std::chrono::seconds(3));  // the motion lasts longer than that
+  const std::string out = (dir_ / "run.out").string();  // runProgram's file, read while it runs
+  std::thread killer([pid, out] {
+    // Once the program moves the arm (connected, the first motion queued), 1 s into the motion
+    // (it lasts several seconds); after 300 s regardless.
+    for (int k = 0; k < 30000 && slurp(out).find("moving") == std::string::npos; ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::this_thread::sleep_for(std::chrono::seconds(1));
     kill(pid, SIGKILL);
   });
   const Outcome remote = run(REMOTE_MOTION_PATH, remoteConfig());
   killer.join();
   EXPECT_EQ(remote.status, RoboticPlatform::kExitAfterShutdown) << remote.out << remote.err;
   EXPECT_TRUE(contains(remote.err, "no joint_states from " + ns_ + "/puma")) << remote.err;
+  EXPECT_TRUE(contains(remote.out, "moving")) << remote.out;
   EXPECT_FALSE(contains(remote.out, "final")) << remote.out;
 }
 

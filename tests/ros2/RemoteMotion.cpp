@@ -1,7 +1,7 @@
 // The motions of the paper's Figure 21 (examples/pick_and_place.cpp) without the gripper and the
 // work piece, written generically as section 3.6 writes programs: the arm is rp.cfg's [leader],
 // whatever its class (a Puma560 here, or a RemoteManipulator driving a Puma in another process).
-// Prints "final q1 ... qn" (the leader's joint positions once at rest [rad]) and ends with 0, or
+// Prints "moving" once the first motion is queued, then "final q1 ... qn" (the leader's joint positions once at rest [rad]) and ends with 0, or
 // with RoboticPlatform::kExitAfterShutdown (3) after a system shutdown (a fault, a vanished remote arm).
 #include <chrono>
 #include <cmath>
@@ -19,6 +19,8 @@ int main(int argc, char* argv[]) {
   arm->setTrajectoryGenerator(tragen);
   Transform down = xRotation(M_PI);
   tragen.moveTo(translation(0, 0.5, 0.12) * down);
+  std::printf("moving\n");  // (for the test that kills the remote arm mid-motion)
+  std::fflush(stdout);
   tragen.stop(1);
   tragen.moveTo(translation(0.5, 0.5, 0.3) * down);
   tragen.moveTo(translation(0.6, 0.2, 0.3) * down);
