@@ -13,4 +13,5 @@
 #include "rp/io/Io.hpp"
 #include "rp/effector/Effector.hpp"
 #include "rp/gui/SceneViewer.hpp"
+#include "rp/ros2/RemoteManipulator.hpp"
 #include "rp/ros2/Ros2Bridge.hpp"

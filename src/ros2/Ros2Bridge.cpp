@@ -18,6 +18,7 @@
 
 #include "../model/ExportFrames.hpp"
 #include "../rt/CycleSignal.hpp"
+#include "Ros2Common.hpp"
 #include "geometry_msgs.h"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/TypeDatabase.hpp"
@@ -37,60 +38,13 @@ namespace rp {
 
 namespace {
 
-constexpr int kMaxDomain = 230;  // Cyclone DDS's largest domain id with the default port mapping
-
-// A ROS namespace: parts of letters, digits and '_', not starting with a digit, between '/'.
-// (Hand-written: GCC 12's std::regex trips -Wmaybe-uninitialized in the sanitizer builds.)
-bool validNamespace(const std::string& ns) {
-  if (ns.size() > 200) return false;
-  std::size_t begin = ns.empty() || ns.front() != '/' ? 0 : 1;
-  std::size_t end = ns.size();
-  if (end > begin && ns[end - 1] == '/') --end;
-  if (begin >= end) return ns.empty();
-  std::size_t partStart = begin;
-  for (std::size_t i = begin; i <= end; ++i) {
-    if (i == end || ns[i] == '/') {
-      if (i == partStart) return false;  // empty part: "a//b"
-      partStart = i + 1;
-      continue;
-    }
-    const auto c = static_cast<unsigned char>(ns[i]);
-    if (!(std::isalnum(c) || c == '_') || (i == partStart && std::isdigit(c))) return false;
-  }
-  return true;
-}
-
-bool validInterface(const std::string& name) {
-  if (name.empty() || name.size() > 40) return false;
-  for (char ch : name) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (!(std::isalnum(c) || c == '_' || c == '.' || c == ':' || c == '@' || c == '-')) return false;
-  }
-  return true;
-}
-
-bool isIpv4Address(const std::string& text) {
-  if (text.empty()) return false;
-  for (char c : text)
-    if (!(std::isdigit(static_cast<unsigned char>(c)) || c == '.')) return false;
-  return true;
-}
-
-// A ROS name made of an object name (rp allows more characters than ROS names).
-std::string rosName(const std::string& name) {
-  std::string out;
-  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' ? c : '_';
-  if (out.empty() || std::isdigit(static_cast<unsigned char>(out[0]))) out = "_" + out;
-  return out;
-}
-
-std::string joined(const std::vector<std::string>& words) {
-  std::string out;
-  for (const std::string& w : words) out += (out.empty() ? "" : " ") + w;
-  return out;
-}
-
-std::string ddsError(dds_return_t r) { return dds_strretcode(r); }
+using ros2detail::ddsError;
+using ros2detail::isIpv4Address;
+using ros2detail::joined;
+using ros2detail::kMaxDomain;
+using ros2detail::rosName;
+using ros2detail::validInterface;
+using ros2detail::validNamespace;
 
 builtin_interfaces_msg_dds__Time_ now() {
   const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -190,12 +144,7 @@ struct Ros2Bridge::Impl {
   // robot_state_publisher offers robot_description; XCDR1 as rmw_cyclonedds writes and reads.
   // A writer, or a reader as a ROS 2 subscription has it (`isReader`).
   dds_entity_t endpoint(const dds_topic_descriptor_t& desc, const std::string& name, bool transientLocal, bool isReader) {
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-    dds_qset_durability(qos, transientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
-    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, transientLocal ? 1 : 10);
-    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
-    dds_qset_data_representation(qos, 1, &xcdr1);
+    dds_qos_t* qos = ros2detail::rosQos(transientLocal);
     const dds_entity_t t = topic(desc, name);
     const dds_entity_t e = isReader ? dds_create_reader(participant, t, qos, nullptr) : dds_create_writer(participant, t, qos, nullptr);
     dds_delete_qos(qos);
@@ -421,14 +370,8 @@ void Ros2Bridge::start() {
   d.nameSpace = ns;
   const auto domainId = static_cast<dds_domainid_t>(d.options.domain);
   const std::string config = cycloneConfig(d.options.interfaces);
-  d.domain = dds_create_domain(domainId, config.c_str());
-  if (d.domain >= 0) {
-    d.ownDomain = true;
-  } else if (d.domain != DDS_RETCODE_PRECONDITION_NOT_MET) {  // not: the domain exists in this process already
-    throw std::runtime_error("Ros2Bridge: DDS domain " + std::to_string(d.options.domain) + " cannot start on " +
-                             joined(d.options.interfaces) + ": " +
-                             ddsError(d.domain) + " (see Cyclone DDS's message above)");
-  }
+  d.domain = ros2detail::createDomain(d.options.domain, config, "Ros2Bridge", joined(d.options.interfaces));
+  d.ownDomain = d.domain > 0;
   d.participant = dds_create_participant(domainId, nullptr, nullptr);
   if (d.participant < 0)
     throw std::runtime_error("Ros2Bridge: cannot join DDS domain " + std::to_string(d.options.domain) + ": " +

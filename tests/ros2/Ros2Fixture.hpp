@@ -22,7 +22,7 @@ inline Ros2BridgeOptions uniqueOptions() {
   Ros2BridgeOptions o;
   o.domain = 1 + static_cast<int>(getpid() % 200);
   o.nameSpace = "t";
-  o.nameSpace += std::to_string(getpid());  // (not "t" + ...: GCC 12's false -Wrestrict when inlined)
+  o.nameSpace += std::to_string(getpid());  // (not "t" + ...: GCC 12's -Wrestrict false positive where inlined)
   o.rate = 100;
   return o;
 }

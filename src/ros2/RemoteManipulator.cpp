@@ -1,0 +1,693 @@
+#include "rp/ros2/RemoteManipulator.hpp"
+
+#include <dds/dds.h>
+#include <stdlib.h>  // mkstemps
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "Ros2Common.hpp"
+#include "rp/core/ObjectManager.hpp"
+#include "rp/core/TypeDatabase.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/model/ManipulatorData.hpp"
+#include "rp/model/UrdfModel.hpp"
+#include "rp/ros2/Ros2Bridge.hpp"
+#include "rp/trajectory/TrajectoryGenerator.hpp"
+#include "sensor_msgs.h"
+#include "std_msgs.h"
+#include "trajectory_msgs.h"
+
+namespace rp {
+
+namespace {
+
+using ros2detail::ddsError;
+using ros2detail::joined;
+
+constexpr double kHorizon = 0.05;   // the setpoint's time_from_start [s]
+constexpr double kStopTime = 0.2;   // the stop after it [s]
+// The local model's joint velocity limits are this fraction of the remote arm's: motions planned
+// here keep a reserve, so that the remote arm can catch up with a streamed setpoint that arrives
+// late (the remote bridge refuses a point it could only reach above its limits). With the 50 ms
+// horizon, a setpoint up to 12 ms late is still reachable.
+constexpr double kVelocityReserve = 0.8;
+constexpr std::size_t kLatencies = 4096;
+
+double wallSeconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+builtin_interfaces_msg_dds__Duration_ duration(double s) {
+  builtin_interfaces_msg_dds__Duration_ d{};
+  d.sec = static_cast<int32_t>(std::floor(s));
+  d.nanosec = static_cast<uint32_t>(std::lround((s - std::floor(s)) * 1e9));
+  if (d.nanosec >= 1000000000u) {
+    ++d.sec;
+    d.nanosec -= 1000000000u;
+  }
+  return d;
+}
+
+// `urdf` with the velocity="..." attribute of every <limit> element multiplied by `factor`.
+std::string scaleVelocityLimits(const std::string& urdf, double factor) {
+  std::string out;
+  out.reserve(urdf.size());
+  std::size_t at = 0;
+  for (std::size_t tag; (tag = urdf.find("<limit", at)) != std::string::npos;) {
+    const std::size_t end = urdf.find('>', tag);
+    if (end == std::string::npos) break;
+    const std::size_t v = urdf.find("velocity=\"", tag);
+    if (v == std::string::npos || v > end) {
+      out.append(urdf, at, end + 1 - at);
+      at = end + 1;
+      continue;
+    }
+    const std::size_t start = v + 10, stop = urdf.find('"', start);
+    if (stop == std::string::npos || stop > end) break;
+    char* parsed = nullptr;
+    const double value = std::strtod(urdf.c_str() + start, &parsed);
+    out.append(urdf, at, start - at);
+    if (parsed == urdf.c_str() + stop && std::isfinite(value)) {
+      std::ostringstream x;
+      x.precision(17);
+      x << value * factor;
+      out += x.str();
+    } else {
+      out.append(urdf, start, stop - start);  // not a number: loadUrdf() says so
+    }
+    at = stop;
+  }
+  out.append(urdf, at, std::string::npos);
+  return out;
+}
+
+// The model of a URDF text (loadUrdf() reads files): written to a temporary file first.
+std::unique_ptr<ManipulatorModel> modelOfUrdf(const std::string& urdf) {
+  const char* dir = std::getenv("TMPDIR");
+  std::string path = std::string(dir != nullptr && *dir != '\0' ? dir : "/tmp") + "/rp-remote-XXXXXX.urdf";
+  const int fd = mkstemps(path.data(), 5);
+  if (fd < 0) throw std::runtime_error("cannot write a temporary file in " + path);
+  const bool written = ::write(fd, urdf.data(), urdf.size()) == static_cast<ssize_t>(urdf.size());
+  ::close(fd);
+  try {
+    if (!written) throw std::runtime_error("cannot write " + path);
+    auto model = loadUrdf(path);
+    ::unlink(path.c_str());
+    return model;
+  } catch (...) {
+    ::unlink(path.c_str());
+    throw;
+  }
+}
+
+}  // namespace
+
+struct RemoteManipulator::Impl {
+  RemoteManipulatorOptions options;
+  std::string nameSpace, object;  // the remote bridge's namespace and the arm's ROS name
+  std::string label;              // "NS/OBJECT" for messages
+  dds_entity_t domain = 0, participant = 0;
+  dds_entity_t jointStates = 0, state = 0, description = 0, trajectory = 0;
+  std::unique_ptr<ManipulatorModel> model;
+  int n = 0;
+  std::vector<std::string> jointNames;  // `<object>_<joint>`, as in joint_states
+
+  // The state received (other threads read it under the lock).
+  mutable std::mutex stateMutex;
+  JointVector q, qd, tau;
+  bool remotePower = false;
+  std::string remoteState;
+  std::uint64_t refusedBaseline = 0;
+  bool haveBaseline = false;
+
+  // The loop's own.
+  JointVector qLoop, hold;
+  Setpoint setpoint;
+  TrajectoryGenerator* activeGenerator = nullptr;
+  std::chrono::steady_clock::time_point lastReceipt;
+  double lastStamp = -1;
+  std::array<int, kMaxJoints> column{};  // model joint -> joint_states column
+
+  std::atomic<TrajectoryGenerator*> generator{nullptr};
+  std::atomic<const void*> executing{nullptr};
+  std::atomic<bool> holdHere{false}, streaming{true}, faulted{false}, remotePowerFlag{false};
+
+  // Statistics (the loop writes under statsMutex).
+  mutable std::mutex statsMutex;
+  std::array<double, kLatencies> latencies{};
+  std::size_t latencyCount = 0;
+  std::uint64_t samples = 0, gaps = 0, missing = 0, sent = 0, failures = 0, refusals = 0;
+  double period = 0;
+
+  // The message written every cycle: buffers made once.
+  std::vector<char*> names;
+  std::array<std::array<double, kMaxJoints>, 2> positions{}, velocities{};
+  std::array<trajectory_msgs_msg_dds__JointTrajectoryPoint_, 2> points{};
+  trajectory_msgs_msg_dds__JointTrajectory_ message{};
+
+  ~Impl() {
+    if (participant > 0) dds_delete(participant);
+    if (domain > 0) dds_delete(domain);
+  }
+
+  dds_entity_t endpoint(const dds_topic_descriptor_t& desc, const std::string& topic, bool transientLocal, bool isReader) {
+    const std::string full = Ros2Bridge::ddsTopicName(nameSpace, topic);
+    const dds_entity_t t = dds_create_topic(participant, &desc, full.c_str(), nullptr, nullptr);
+    if (t < 0) throw std::runtime_error("RemoteManipulator: cannot create topic " + full + ": " + ddsError(t));
+    dds_qos_t* qos = ros2detail::rosQos(transientLocal);
+    const dds_entity_t e = isReader ? dds_create_reader(participant, t, qos, nullptr) : dds_create_writer(participant, t, qos, nullptr);
+    dds_delete_qos(qos);
+    if (e < 0) throw std::runtime_error("RemoteManipulator: cannot create an endpoint on " + full + ": " + ddsError(e));
+    return e;
+  }
+
+  // Takes every joint_states sample received; true if one of the arm's came.
+  bool takeJointStates(RemoteManipulator& self);
+  // Takes every `<object>/state` sample; returns a fault message ("" if none).
+  std::string takeStates();
+  void write(const Setpoint& s, const JointVector& qmin, const JointVector& qmax);
+};
+
+bool RemoteManipulator::Impl::takeJointStates(RemoteManipulator& self) {
+  (void)self;
+  bool got = false;
+  for (;;) {
+    void* loan[1] = {nullptr};
+    dds_sample_info_t info[1];
+    const dds_return_t count = dds_take(jointStates, loan, info, 1, 1);
+    if (count <= 0) break;
+    const auto& js = *static_cast<const sensor_msgs_msg_dds__JointState_*>(loan[0]);
+    bool ours = info[0].valid_data && js.name._length >= static_cast<uint32_t>(n) && js.position._length == js.name._length;
+    if (ours) {  // the arm's sample: each of its joints named in it
+      for (int i = 0; i < n && ours; ++i) {
+        int c = -1;
+        for (uint32_t k = 0; k < js.name._length; ++k)
+          if (js.name._buffer[k] != nullptr && jointNames[static_cast<std::size_t>(i)] == js.name._buffer[k]) c = static_cast<int>(k);
+        ours = c >= 0;
+        column[static_cast<std::size_t>(i)] = c;
+      }
+    }
+    if (ours) {
+      const double receipt = wallSeconds();
+      const double stamp = js.header.stamp.sec + 1e-9 * js.header.stamp.nanosec;
+      {
+        std::lock_guard<std::mutex> lock(stateMutex);
+        for (int i = 0; i < n; ++i) {
+          const auto c = static_cast<uint32_t>(column[static_cast<std::size_t>(i)]);
+          q(i) = js.position._buffer[c];
+          qd(i) = js.velocity._length == js.name._length ? js.velocity._buffer[c] : 0.0;
+          tau(i) = js.effort._length == js.name._length ? js.effort._buffer[c] : 0.0;
+        }
+        qLoop = q;
+      }
+      std::lock_guard<std::mutex> lock(statsMutex);
+      ++samples;
+      latencies[latencyCount++ % kLatencies] = receipt - stamp;
+      if (lastStamp >= 0 && stamp > lastStamp) {
+        const double dt = stamp - lastStamp;
+        if (period == 0 || dt < period) period = dt;
+        if (dt > 1.5 * period) {
+          ++gaps;
+          missing += static_cast<std::uint64_t>(std::max(0.0, std::round(dt / period) - 1));
+        }
+      }
+      lastStamp = stamp;
+      got = true;
+    }
+    dds_return_loan(jointStates, loan, count);
+  }
+  if (got) lastReceipt = std::chrono::steady_clock::now();
+  return got;
+}
+
+std::string RemoteManipulator::Impl::takeStates() {
+  std::string fault;
+  for (;;) {
+    void* loan[1] = {nullptr};
+    dds_sample_info_t info[1];
+    const dds_return_t count = dds_take(state, loan, info, 1, 1);
+    if (count <= 0) break;
+    const auto& s = *static_cast<const std_msgs_msg_dds__String_*>(loan[0]);
+    if (info[0].valid_data && s.data != nullptr) {
+      const std::string text = s.data;
+      const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+      if (j.is_object()) {
+        const bool power = j.value("power", false);
+        const auto refused = j.value("trajectoriesRefused", std::uint64_t{0});
+        {
+          std::lock_guard<std::mutex> lock(stateMutex);
+          remoteState = text;
+          remotePower = power;
+          if (!haveBaseline) {
+            refusedBaseline = refused;
+            haveBaseline = true;
+          }
+        }
+        remotePowerFlag = power;
+        if (j.value("errorCode", 0) != 0)
+          fault = "the remote arm " + label + " reports an error: " + j.value("error", std::string());
+        else if (j.value("shutdown", false))
+          fault = "the remote arm " + label + " is shutting down: " + j.value("shutdownReason", std::string());
+        else if (refused > refusedBaseline) {
+          {
+            std::lock_guard<std::mutex> lock(statsMutex);
+            refusals = refused - refusedBaseline;
+          }
+          fault = "the remote arm " + label + " refused the trajectory: " + j.value("trajectory", std::string());
+        }
+      }
+    }
+    dds_return_loan(state, loan, count);
+  }
+  return fault;
+}
+
+void RemoteManipulator::Impl::write(const Setpoint& s, const JointVector& qmin, const JointVector& qmax) {
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double p = s.position(i), v = s.velocity.size() == n ? s.velocity(i) : 0.0;
+    positions[0][k] = p;
+    velocities[0][k] = v;
+    // The stop from there at constant deceleration (a cubic with these ends is exactly that).
+    positions[1][k] = std::clamp(p + v * kStopTime / 2, qmin(i), qmax(i));
+    velocities[1][k] = 0;
+  }
+  if (dds_write(trajectory, &message) < 0) {
+    std::lock_guard<std::mutex> lock(statsMutex);
+    ++failures;
+  } else {
+    std::lock_guard<std::mutex> lock(statsMutex);
+    ++sent;
+  }
+}
+
+RemoteManipulator::RemoteManipulator(const std::string& name)
+    : Manipulator(ClassSection(name, "RemoteManipulator")), ControlProgram(name.empty() ? "remote" : name), impl_(std::make_unique<Impl>()) {
+  setProgramName(getName());
+  RemoteManipulatorOptions& o = impl_->options;
+  const ConfigSection* section = configSection();
+  if (section == nullptr)
+    throw std::invalid_argument("RemoteManipulator '" + getName() + "': no rp.cfg section [" + getName() +
+                                "] with the setting 'remote NS/OBJECT'");
+  const ConfigSetting* remote = section->find("remote");
+  if (remote == nullptr)
+    throw ConfigError(section->fileName(), section->line(),
+                      "RemoteManipulator needs the setting 'remote NS/OBJECT' (the remote Ros2Bridge's namespace and the arm's name)");
+  if (remote->values.size() != 1) throw section->errorAt(*remote, "setting 'remote' takes one word, NS/OBJECT");
+  o.remote = remote->values[0];
+  if (const ConfigSetting* s = section->find("domain")) {
+    const double d = section->getNumbers("domain").at(0);
+    if (!(d >= 0 && d <= ros2detail::kMaxDomain) || d != std::floor(d))
+      throw section->errorAt(*s, "setting 'domain' must be a whole number 0 .. " + std::to_string(ros2detail::kMaxDomain));
+    o.domain = static_cast<int>(d);
+  }
+  if (const ConfigSetting* s = section->find("interfaces")) {
+    if (s->values.empty()) throw section->errorAt(*s, "setting 'interfaces' needs at least one interface");
+    o.interfaces = s->values;
+  }
+  if (section->find("rate")) o.rate = section->getNumbers("rate").at(0);
+  if (section->find("timeout")) o.timeout = section->getNumbers("timeout").at(0);
+  if (section->find("connectTimeout")) o.connectTimeout = section->getNumbers("connectTimeout").at(0);
+  if (const std::string why = checkOptions(o); !why.empty()) {
+    for (const char* key : {"remote", "interfaces", "rate", "timeout", "connectTimeout"})
+      if (why.rfind(key, 0) == 0)
+        if (const ConfigSetting* s = section->find(key)) throw section->errorAt(*s, "setting " + why);
+    throw ConfigError(section->fileName(), section->line(), why);
+  }
+  try {
+    connect();
+  } catch (const std::exception& e) {
+    throw section->errorAt(*remote, std::string("setting 'remote ") + o.remote + "': " + e.what());
+  }
+  startControlLoop();
+}
+
+RemoteManipulator::RemoteManipulator(const std::string& name, const RemoteManipulatorOptions& options)
+    : Manipulator(name), ControlProgram(name.empty() ? "remote" : name), impl_(std::make_unique<Impl>()) {
+  setProgramName(getName());
+  if (const std::string why = checkOptions(options); !why.empty()) throw std::invalid_argument("RemoteManipulator: " + why);
+  impl_->options = options;
+  connect();
+  startControlLoop();
+}
+
+RemoteManipulator::~RemoteManipulator() {
+  stopControlLoop();
+  const RemoteManipulatorStatistics s = getStatistics();
+  if (s.gaps > 0 || s.writeFailures > 0)
+    std::fprintf(stderr,
+                 "RemoteManipulator '%s': %llu joint_states samples from %s, %llu gaps (about %llu lost), latency median %.3f ms, "
+                 "p99 %.3f ms; %llu trajectories sent, %llu write failures\n",
+                 getName().c_str(), static_cast<unsigned long long>(s.samples), impl_->label.c_str(),
+                 static_cast<unsigned long long>(s.gaps), static_cast<unsigned long long>(s.missing), 1e3 * s.latencyMedian,
+                 1e3 * s.latencyP99, static_cast<unsigned long long>(s.trajectoriesSent),
+                 static_cast<unsigned long long>(s.writeFailures));
+  if (TrajectoryGenerator* g = impl_->generator.exchange(nullptr)) {
+    disconnectGenerator(*g);
+    g->detach(*this);
+  }
+  impl_.reset();
+}
+
+std::string RemoteManipulator::checkOptions(const RemoteManipulatorOptions& o) {
+  const std::size_t slash = o.remote.rfind('/');
+  const std::string object = slash == std::string::npos ? o.remote : o.remote.substr(slash + 1);
+  const std::string ns = slash == std::string::npos ? "" : o.remote.substr(0, slash);
+  if (o.remote.empty() || object.empty() || !ros2detail::validNamespace(ns) || (!ns.empty() && ns.back() == '/') ||
+      ros2detail::rosName(object) != object)
+    return "remote '" + o.remote + "' is not NS/OBJECT (a ROS namespace, then the arm's object name)";
+  if (o.domain < 0 || o.domain > ros2detail::kMaxDomain) return "domain must be 0 .. " + std::to_string(ros2detail::kMaxDomain);
+  if (o.interfaces.empty()) return "interfaces must name at least one interface";
+  for (const std::string& v : o.interfaces)
+    if (!ros2detail::validInterface(v)) return "interfaces: '" + v + "' is not an interface name or address";
+  if (!(o.rate >= 10 && o.rate <= 500)) return "rate must be 10 .. 500 Hz";
+  if (!(o.timeout >= 0.05 && o.timeout <= 60)) return "timeout must be 0.05 .. 60 s";
+  if (!(o.connectTimeout >= 0.1 && o.connectTimeout <= 600)) return "connectTimeout must be 0.1 .. 600 s";
+  return "";
+}
+
+void RemoteManipulator::declareSettings(SettingSchema& schema) {
+  RoboticObject::declareSettings(schema);
+  schema.addWord("remote", "required: the remote arm, the remote Ros2Bridge's namespace / the arm's object name, e.g. cell1/puma");
+  schema.addInteger("domain", "DDS domain id (ROS_DOMAIN_ID) of the remote bridge", 0, ros2detail::kMaxDomain);
+  SettingSpec interfaces;
+  interfaces.name = "interfaces";
+  interfaces.kind = SettingKind::Word;
+  interfaces.minValues = 1;
+  interfaces.maxValues = 16;
+  interfaces.description = "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice";
+  schema.add(interfaces);
+  schema.addNumbers("rate", 1, "Hz", "setpoints streamed to the remote arm per second", 10, 500);
+  schema.addNumbers("timeout", 1, "s", "silence of the remote arm's joint_states that is a fault", 0.05, 60);
+  schema.addNumbers("connectTimeout", 1, "s", "longest wait for the remote arm at construction", 0.1, 600);
+  schema.setDefault("domain", "0");
+  schema.setDefault("interfaces", "lo");
+  schema.setDefault("rate", "100");
+  schema.setDefault("timeout", "0.5");
+  schema.setDefault("connectTimeout", "10");
+}
+
+void RemoteManipulator::connect() {
+  Impl& d = *impl_;
+  const RemoteManipulatorOptions& o = d.options;
+  const std::size_t slash = o.remote.rfind('/');
+  d.object = slash == std::string::npos ? o.remote : o.remote.substr(slash + 1);
+  d.nameSpace = slash == std::string::npos ? "" : o.remote.substr(0, slash);
+  while (!d.nameSpace.empty() && d.nameSpace.front() == '/') d.nameSpace.erase(0, 1);
+  d.label = d.nameSpace.empty() ? d.object : d.nameSpace + "/" + d.object;
+  d.domain = ros2detail::createDomain(o.domain, Ros2Bridge::cycloneConfig(o.interfaces), "RemoteManipulator", joined(o.interfaces));
+  d.participant = dds_create_participant(static_cast<dds_domainid_t>(o.domain), nullptr, nullptr);
+  if (d.participant < 0)
+    throw std::runtime_error("cannot join DDS domain " + std::to_string(o.domain) + ": " + ddsError(d.participant));
+  d.description = d.endpoint(std_msgs_msg_dds__String__desc, d.object + "/robot_description", true, true);
+  d.state = d.endpoint(std_msgs_msg_dds__String__desc, d.object + "/state", false, true);
+  d.jointStates = d.endpoint(sensor_msgs_msg_dds__JointState__desc, "joint_states", false, true);
+  d.trajectory = d.endpoint(trajectory_msgs_msg_dds__JointTrajectory__desc, d.object + "/joint_trajectory", false, false);
+
+  // The description (transient-local: the bridge's last sample comes on discovery).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.connectTimeout);
+  std::string urdf;
+  while (urdf.empty()) {
+    void* loan[1] = {nullptr};
+    dds_sample_info_t info[1];
+    const dds_return_t count = dds_take(d.description, loan, info, 1, 1);
+    if (count > 0) {
+      const auto& s = *static_cast<const std_msgs_msg_dds__String_*>(loan[0]);
+      if (info[0].valid_data && s.data != nullptr) urdf = s.data;
+      dds_return_loan(d.description, loan, count);
+      continue;
+    }
+    if (std::chrono::steady_clock::now() > deadline)
+      throw std::runtime_error("no robot description on " + Ros2Bridge::ddsTopicName(d.nameSpace, d.object + "/robot_description") +
+                               " (domain " + std::to_string(o.domain) + ", interfaces " + joined(o.interfaces) + ") within " +
+                               std::to_string(o.connectTimeout) + " s: is the remote arm's process running with a Ros2Bridge?");
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  d.model = modelOfUrdf(scaleVelocityLimits(urdf, kVelocityReserve));
+  d.n = d.model->getNumberOfJoints();
+  const std::string prefix = d.object + "_";
+  for (int i = 0; i < d.n; ++i) {
+    const std::string j = d.model->getJointName(i);
+    d.jointNames.push_back(j.rfind(prefix, 0) == 0 ? j : prefix + j);
+  }
+  for (JointVector* v : {&d.q, &d.qd, &d.tau, &d.qLoop, &d.hold}) v->setZero(d.n);
+  for (JointVector* v : {&d.setpoint.position, &d.setpoint.velocity, &d.setpoint.acceleration}) v->setZero(d.n);
+
+  // The first joint state and state of the arm.
+  bool joints = false;
+  while (!joints || !d.haveBaseline) {
+    joints = d.takeJointStates(*this) || joints;
+    const std::string fault = d.takeStates();
+    if (!fault.empty()) throw std::runtime_error(fault);
+    if (joints && d.haveBaseline) break;
+    if (std::chrono::steady_clock::now() > deadline)
+      throw std::runtime_error(std::string("no ") + (joints ? "state" : "joint_states") + " of the arm on " +
+                               Ros2Bridge::ddsTopicName(d.nameSpace, joints ? d.object + "/state" : "joint_states") +
+                               " within " + std::to_string(o.connectTimeout) + " s (its description came)");
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  d.hold = d.qLoop;
+
+  // The message: names and the two points' buffers, made once.
+  for (const std::string& name : d.jointNames) d.names.push_back(const_cast<char*>(name.c_str()));
+  const auto dof = static_cast<uint32_t>(d.n);
+  d.message.header.frame_id = const_cast<char*>("");
+  d.message.joint_names._buffer = d.names.data();
+  d.message.joint_names._length = d.message.joint_names._maximum = dof;
+  for (std::size_t k = 0; k < 2; ++k) {
+    auto& p = d.points[k];
+    p.positions._buffer = d.positions[k].data();
+    p.velocities._buffer = d.velocities[k].data();
+    p.positions._length = p.positions._maximum = dof;
+    p.velocities._length = p.velocities._maximum = dof;
+    p.time_from_start = duration(k == 0 ? kHorizon : kHorizon + kStopTime);
+  }
+  d.message.points._buffer = d.points.data();
+  d.message.points._length = d.message.points._maximum = 2;
+
+  setRate(o.rate);
+  setThreadMode(ThreadMode::Own);
+}
+
+void RemoteManipulator::control() {
+  Impl& d = *impl_;
+  d.takeJointStates(*this);
+  std::string fault;
+  try {
+    fault = d.takeStates();
+  } catch (const std::exception& e) {
+    fault = std::string("the remote arm's state: ") + e.what();
+  }
+  if (fault.empty() && std::chrono::steady_clock::now() - d.lastReceipt > std::chrono::duration<double>(d.options.timeout)) {
+    char text[160];
+    std::snprintf(text, sizeof text, "no joint_states from %.60s for %.2f s: the remote arm or its process is gone", d.label.c_str(),
+                  d.options.timeout);
+    fault = text;
+  }
+  if (!fault.empty() && !d.faulted.exchange(true)) {
+    const std::string message = "RemoteManipulator '" + getName() + "': " + fault;
+    setError(1, message.c_str());
+    ObjectManager::requestSystemShutdown(message.c_str());
+  }
+
+  TrajectoryGenerator* g = d.generator.load(std::memory_order_acquire);
+  const bool changes = g != d.activeGenerator;
+  d.activeGenerator = g;
+  const bool holdRequested = d.holdHere.exchange(false);
+  const bool on = d.streaming.load() && !d.faulted.load() && d.remotePowerFlag.load() && !ObjectManager::isShutdownRequested();
+  if (!on || changes || holdRequested) d.hold = d.qLoop;
+  d.setpoint.position = d.hold;
+  d.setpoint.velocity.setZero();
+  d.setpoint.acceleration.setZero();
+  if (g == nullptr || !on) return;
+  d.executing.store(g, std::memory_order_seq_cst);
+  std::string bad;
+  try {
+    if (d.generator.load(std::memory_order_seq_cst) == g && g->getCurrentSetpoint(getTime(), d.setpoint)) {
+      if (!(d.setpoint.position.allFinite() && d.setpoint.velocity.allFinite()))
+        bad = "the trajectory generator gave a setpoint that is not a number";
+      else
+        d.hold = d.setpoint.position;
+    }
+  } catch (const std::exception& e) {
+    bad = std::string("the trajectory generator threw: ") + e.what();
+  }
+  d.executing.store(nullptr, std::memory_order_release);
+  if (!bad.empty()) {
+    if (!d.faulted.exchange(true)) {
+      const std::string message = "RemoteManipulator '" + getName() + "': " + bad;
+      setError(1, message.c_str());
+      ObjectManager::requestSystemShutdown(message.c_str());
+    }
+    return;
+  }
+  d.write(d.setpoint, d.model->getPositionMin(), d.model->getPositionMax());
+}
+
+const RemoteManipulatorOptions& RemoteManipulator::getOptions() const noexcept { return impl_->options; }
+
+RemoteManipulatorStatistics RemoteManipulator::getStatistics() const {
+  const Impl& d = *impl_;
+  RemoteManipulatorStatistics s;
+  std::vector<double> l;
+  {
+    std::lock_guard<std::mutex> lock(d.statsMutex);
+    s.samples = d.samples;
+    s.gaps = d.gaps;
+    s.missing = d.missing;
+    s.period = d.period;
+    s.trajectoriesSent = d.sent;
+    s.writeFailures = d.failures;
+    s.remoteRefusals = d.refusals;
+    l.assign(d.latencies.begin(), d.latencies.begin() + static_cast<std::ptrdiff_t>(std::min(d.latencyCount, kLatencies)));
+  }
+  if (!l.empty()) {
+    std::sort(l.begin(), l.end());
+    s.latencyMedian = l[l.size() / 2];
+    s.latencyP99 = l[std::min(l.size() - 1, l.size() * 99 / 100)];
+    s.latencyMax = l.back();
+  }
+  return s;
+}
+
+std::string RemoteManipulator::getRemoteState() const {
+  std::lock_guard<std::mutex> lock(impl_->stateMutex);
+  return impl_->remoteState;
+}
+
+const ManipulatorModel& RemoteManipulator::getModel() const { return *impl_->model; }
+
+double RemoteManipulator::getServoPeriod() const { return 1.0 / impl_->options.rate; }
+
+JointVector RemoteManipulator::getJointPosition() const {
+  std::lock_guard<std::mutex> lock(impl_->stateMutex);
+  return impl_->q;
+}
+
+JointVector RemoteManipulator::getJointVelocity() const {
+  std::lock_guard<std::mutex> lock(impl_->stateMutex);
+  return impl_->qd;
+}
+
+const Setpoint& RemoteManipulator::getSetpoint() const { return impl_->setpoint; }
+
+JointVector RemoteManipulator::getControlOutput() const {
+  std::lock_guard<std::mutex> lock(impl_->stateMutex);
+  return impl_->tau;
+}
+
+void RemoteManipulator::setControlOutput(const Eigen::Ref<const Eigen::VectorXd>& torque) {
+  (void)torque;
+  throw std::logic_error("RemoteManipulator '" + getName() + "': the torques of a remote arm are its own process's");
+}
+
+void RemoteManipulator::enableArmPower() {
+  if (impl_->faulted) throw std::runtime_error("RemoteManipulator '" + getName() + "': " + getErrorStatus().message);
+  if (!impl_->remotePowerFlag)
+    throw std::runtime_error("RemoteManipulator '" + getName() + "': the remote arm " + impl_->label +
+                             " reports its power off (switch it on in its own process)");
+  if (!impl_->streaming.exchange(true)) impl_->holdHere = true;
+}
+
+void RemoteManipulator::disableArmPower() { impl_->streaming = false; }
+
+bool RemoteManipulator::isArmPowerOn() const { return impl_->streaming && impl_->remotePowerFlag && !impl_->faulted; }
+
+Transform RemoteManipulator::getEndEffectorTransform() const {
+  ManipulatorData data(*impl_->model);
+  return forwardKinematics(*impl_->model, data, getJointPosition());
+}
+
+void RemoteManipulator::endEffectorForceToJointTorque(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                                      const Eigen::Ref<const Eigen::VectorXd>& force,
+                                                      Eigen::Ref<Eigen::VectorXd> torque) const {
+  ManipulatorData data(*impl_->model);
+  const JointVector qv = q;
+  rp::endEffectorForceToJointTorque(*impl_->model, data, qv, force, torque, ReferenceFrame::Base);
+}
+
+void RemoteManipulator::setTrajectoryGenerator(TrajectoryGenerator& generator) {
+  generator.attach(*this);
+  connectGenerator(generator);
+  TrajectoryGenerator* old = impl_->generator.exchange(&generator);
+  if (old != nullptr && old != &generator) {
+    while (isRunning() && impl_->executing.load() == old) std::this_thread::yield();
+    disconnectGenerator(*old);
+    old->detach(*this);
+  }
+}
+
+void RemoteManipulator::clearTrajectoryGenerator() {
+  impl_->holdHere = true;
+  TrajectoryGenerator* old = impl_->generator.exchange(nullptr);
+  if (old != nullptr) {
+    while (isRunning() && impl_->executing.load() == old) std::this_thread::yield();
+    disconnectGenerator(*old);
+    old->detach(*this);
+  }
+}
+
+TrajectoryGenerator* RemoteManipulator::getTrajectoryGenerator() const { return impl_->generator.load(); }
+
+void RemoteManipulator::releaseTrajectoryGenerator(TrajectoryGenerator& generator) {
+  TrajectoryGenerator* expected = &generator;
+  if (impl_->generator.compare_exchange_strong(expected, nullptr)) impl_->holdHere = true;
+  while (isRunning() && impl_->executing.load() == &generator) std::this_thread::yield();
+  disconnectGenerator(generator);
+}
+
+void RemoteManipulator::setServoControl(ServoControl& control) {
+  (void)control;
+  throw std::logic_error("RemoteManipulator '" + getName() + "': the servo control of a remote arm runs in its own process");
+}
+
+ServoControl& RemoteManipulator::getServoControl() const {
+  throw std::logic_error("RemoteManipulator '" + getName() + "': the servo control of a remote arm runs in its own process");
+}
+
+void RemoteManipulator::releaseServoControl(ServoControl& control) { (void)control; }
+
+void RemoteManipulator::setGravityCompensationOn() {
+  throw std::logic_error("RemoteManipulator '" + getName() + "': gravity compensation is the remote arm's process's");
+}
+
+void RemoteManipulator::setGravityCompensationOff() { setGravityCompensationOn(); }
+
+bool RemoteManipulator::isGravityCompensationOn() const { return true; }
+
+void RemoteManipulator::setZeroGravityModeOn() {
+  throw std::logic_error("RemoteManipulator '" + getName() + "': zero-gravity mode is the remote arm's process's");
+}
+
+void RemoteManipulator::setZeroGravityModeOff() {}
+
+bool RemoteManipulator::isZeroGravityModeOn() const { return false; }
+
+void RemoteManipulator::applyExternalWrench(const Vector<6>& wrench) {
+  (void)wrench;
+  throw std::logic_error("RemoteManipulator '" + getName() + "': external wrenches act on the remote arm's own simulation");
+}
+
+void RemoteManipulator::applyExternalWrench(int link, const Vector<3>& point, const Vector<6>& wrench) {
+  (void)link;
+  (void)point;
+  applyExternalWrench(wrench);
+}
+
+}  // namespace rp
+
+RP_REGISTER_CLASS_AS(rp::RemoteManipulator, "RemoteManipulator");

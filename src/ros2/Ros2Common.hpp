@@ -1,0 +1,94 @@
+#pragma once
+// Internal to src/ros2: the wire conventions shared by Ros2Bridge and RemoteManipulator (names,
+// ROS 2's default QoS as rmw_cyclonedds has it, joining a DDS domain restricted to interfaces).
+// Moved here from Ros2Bridge.cpp; not installed.
+
+#include <dds/dds.h>
+
+#include <cctype>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace rp::ros2detail {
+
+constexpr int kMaxDomain = 230;  // Cyclone DDS's largest domain id with the default port mapping
+
+// A ROS namespace: parts of letters, digits and '_', not starting with a digit, between '/'.
+// (Hand-written: GCC 12's std::regex trips -Wmaybe-uninitialized in the sanitizer builds.)
+inline bool validNamespace(const std::string& ns) {
+  if (ns.size() > 200) return false;
+  std::size_t begin = ns.empty() || ns.front() != '/' ? 0 : 1;
+  std::size_t end = ns.size();
+  if (end > begin && ns[end - 1] == '/') --end;
+  if (begin >= end) return ns.empty();
+  std::size_t partStart = begin;
+  for (std::size_t i = begin; i <= end; ++i) {
+    if (i == end || ns[i] == '/') {
+      if (i == partStart) return false;  // empty part: "a//b"
+      partStart = i + 1;
+      continue;
+    }
+    const auto c = static_cast<unsigned char>(ns[i]);
+    if (!(std::isalnum(c) || c == '_') || (i == partStart && std::isdigit(c))) return false;
+  }
+  return true;
+}
+
+inline bool validInterface(const std::string& name) {
+  if (name.empty() || name.size() > 40) return false;
+  for (char ch : name) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (!(std::isalnum(c) || c == '_' || c == '.' || c == ':' || c == '@' || c == '-')) return false;
+  }
+  return true;
+}
+
+inline bool isIpv4Address(const std::string& text) {
+  if (text.empty()) return false;
+  for (char c : text)
+    if (!(std::isdigit(static_cast<unsigned char>(c)) || c == '.')) return false;
+  return true;
+}
+
+// A ROS name made of an object name (rp allows more characters than ROS names).
+inline std::string rosName(const std::string& name) {
+  std::string out;
+  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' ? c : '_';
+  if (out.empty() || std::isdigit(static_cast<unsigned char>(out[0]))) out = "_" + out;
+  return out;
+}
+
+inline std::string joined(const std::vector<std::string>& words) {
+  std::string out;
+  for (const std::string& w : words) out += (out.empty() ? "" : " ") + w;
+  return out;
+}
+
+inline std::string ddsError(dds_return_t r) { return dds_strretcode(r); }
+
+// ROS 2's default QoS (reliable, volatile, keep-last 10), or transient-local keep-last 1 as
+// robot_state_publisher offers robot_description; XCDR1 as rmw_cyclonedds writes and reads.
+// The caller deletes it (dds_delete_qos).
+inline dds_qos_t* rosQos(bool transientLocal) {
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_durability(qos, transientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, transientLocal ? 1 : 10);
+  dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+  dds_qset_data_representation(qos, 1, &xcdr1);
+  return qos;
+}
+
+// Creates DDS domain `domain` restricted by `config` (Ros2Bridge::cycloneConfig()) unless this
+// process has it already. Returns the domain entity to delete later, 0 if it existed.
+// `who` and `interfaces` name the caller and the interfaces in the exception.
+inline dds_entity_t createDomain(int domain, const std::string& config, const std::string& who, const std::string& interfaces) {
+  const dds_entity_t d = dds_create_domain(static_cast<dds_domainid_t>(domain), config.c_str());
+  if (d >= 0) return d;
+  if (d == DDS_RETCODE_PRECONDITION_NOT_MET) return 0;  // the domain exists in this process already
+  throw std::runtime_error(who + ": DDS domain " + std::to_string(domain) + " cannot start on " + interfaces + ": " +
+                           ddsError(d) + " (see Cyclone DDS's message above)");
+}
+
+}  // namespace rp::ros2detail
