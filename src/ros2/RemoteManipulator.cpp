@@ -384,13 +384,7 @@ void RemoteManipulator::declareSettings(SettingSchema& schema) {
   RoboticObject::declareSettings(schema);
   schema.addWord("remote", "required: the remote arm, the remote Ros2Bridge's namespace / the arm's object name, e.g. cell1/puma");
   schema.addInteger("domain", "DDS domain id (ROS_DOMAIN_ID) of the remote bridge", 0, ros2detail::kMaxDomain);
-  SettingSpec interfaces;
-  interfaces.name = "interfaces";
-  interfaces.kind = SettingKind::Word;
-  interfaces.minValues = 1;
-  interfaces.maxValues = 16;
-  interfaces.description = "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice";
-  schema.add(interfaces);
+  ros2detail::addInterfacesSetting(schema);
   schema.addNumbers("rate", 1, "Hz", "setpoints streamed to the remote arm per second", 10, 500);
   schema.addNumbers("timeout", 1, "s", "silence of the remote arm's joint_states that is a fault", 0.05, 60);
   schema.addNumbers("connectTimeout", 1, "s", "longest wait for the remote arm at construction", 0.1, 600);

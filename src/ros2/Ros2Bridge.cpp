@@ -259,13 +259,7 @@ void Ros2Bridge::declareSettings(SettingSchema& schema) {
   schema.addInteger("domain", "DDS domain id (ROS_DOMAIN_ID)", 0, kMaxDomain);
   schema.addWord("namespace", "ROS namespace of the topics, e.g. cell1");
   schema.addWord("rate", "joint_states and tf samples per second, 1 .. 1000 Hz, or servo: every servo cycle");
-  SettingSpec interfaces;
-  interfaces.name = "interfaces";
-  interfaces.kind = SettingKind::Word;
-  interfaces.minValues = 1;
-  interfaces.maxValues = 16;
-  interfaces.description = "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice";
-  schema.add(interfaces);
+  ros2detail::addInterfacesSetting(schema);
   schema.setDefault("domain", "0");
   schema.setDefault("namespace", "(none)");
   schema.setDefault("rate", "50");

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "rp/core/Configuration.hpp"
+
 namespace rp::ros2detail {
 
 constexpr int kMaxDomain = 230;  // Cyclone DDS's largest domain id with the default port mapping
@@ -89,6 +91,17 @@ inline dds_entity_t createDomain(int domain, const std::string& config, const st
   if (d == DDS_RETCODE_PRECONDITION_NOT_MET) return 0;  // the domain exists in this process already
   throw std::runtime_error(who + ": DDS domain " + std::to_string(domain) + " cannot start on " + interfaces + ": " +
                            ddsError(d) + " (see Cyclone DDS's message above)");
+}
+
+// Declares the `interfaces` setting (one to 16 words), as the bridge and a remote arm take it.
+inline void addInterfacesSetting(SettingSchema& schema) {
+  SettingSpec interfaces;
+  interfaces.name = "interfaces";
+  interfaces.kind = SettingKind::Word;
+  interfaces.minValues = 1;
+  interfaces.maxValues = 16;
+  interfaces.description = "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice";
+  schema.add(interfaces);
 }
 
 }  // namespace rp::ros2detail
