@@ -57,14 +57,16 @@ builtin_interfaces_msg_dds__Time_ now() {
 }
 
 // The wall-clock time of the servo cycle that took a snapshot at clock time `cycleTime`: on the
-// real clock, the time of publication minus the snapshot's age; on a simulated clock (whose time
-// is not the wall's) the time of publication.
+// real clock, the wall clock now minus the snapshot's age (both clocks read back to back); on a
+// simulated clock (whose time is not the wall's) the time of publication.
 builtin_interfaces_msg_dds__Time_ cycleStamp(Manipulator& m, double cycleTime, const builtin_interfaces_msg_dds__Time_& publishedAt) {
   const ControlProgram* program = m.getControlProgram();
   if (program == nullptr || program->getClock().isSimulated()) return publishedAt;
-  const double age = program->getClock().getTime() - cycleTime;
+  const double clockNow = program->getClock().getTime();
+  const builtin_interfaces_msg_dds__Time_ wallNow = now();
+  const double age = clockNow - cycleTime;
   if (!(age >= 0 && age < 1)) return publishedAt;
-  const std::int64_t ns = static_cast<std::int64_t>(publishedAt.sec) * 1000000000LL + publishedAt.nanosec -
+  const std::int64_t ns = static_cast<std::int64_t>(wallNow.sec) * 1000000000LL + wallNow.nanosec -
                           static_cast<std::int64_t>(age * 1e9);
   builtin_interfaces_msg_dds__Time_ t{};
   t.sec = static_cast<int32_t>(ns / 1000000000LL);

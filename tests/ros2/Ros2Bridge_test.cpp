@@ -376,12 +376,14 @@ TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithIts
   // stamped when it was published.
   for (std::size_t k = 2; k < stamps.size(); ++k) {
     const double periods = (stamps[k] - stamps[k - 1]) / period;
-    EXPECT_GE(periods, 0.95) << "sample " << k << ": not a later cycle";
-    EXPECT_NEAR(periods, std::round(periods), 0.05) << "sample " << k << ": not a cycle's time";
+    // To within a tenth of a period: the stamp is the wall clock minus the snapshot's age, two
+    // clocks read one after the other (microseconds apart, more when the thread is preempted).
+    EXPECT_GE(periods, 0.9) << "sample " << k << ": not a later cycle";
+    EXPECT_NEAR(periods, std::round(periods), 0.1) << "sample " << k << ": not a cycle's time";
     gaps.push_back(periods);
   }
   std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
-  EXPECT_NEAR(gaps[gaps.size() / 2], 1.0, 0.05) << "the median sample is not the next servo cycle";
+  EXPECT_NEAR(gaps[gaps.size() / 2], 1.0, 0.1) << "the median sample is not the next servo cycle";
 }
 
 }  // namespace
