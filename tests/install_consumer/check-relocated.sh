@@ -87,26 +87,34 @@ cd "$run" # no rp.cfg here: a simulated Puma 560
 # Runs the installed rp-jointmove (environment changes for env first), fetches the page whose URL
 # (with its token) it prints, checks that the page carries `expect` and not `reject`, that its
 # script is the one in `root`, and that SIGINT ends the program with 130.
+runs=0
 serve() {
   local expect=$1 reject=$2 root=$3
   shift 3
+  # Each run's output in files of its own: the redirection of the program started in the
+  # background may happen after the first look at the file, which then still held the previous
+  # run's URL (a fetch from a port already closed: seen once in CI). Made empty beforehand, so
+  # that the first look finds a file.
+  runs=$((runs + 1))
+  local err=err$runs.txt
+  : >"$err"
   "${launcher[@]}" env -u LD_LIBRARY_PATH "$@" "$program" -simclock -gui-address 127.0.0.1 -gui-port 0 \
-    -gui-token "rp$$" >out.txt 2>err.txt &
+    -gui-token "rp$$" >"out$runs.txt" 2>"$err" &
   pid=$!
   local url=
   for _ in $(seq 600); do # up to 60 s on a loaded machine
-    url=$(sed -n 's/^rp: Scene Viewer at \(http[^ ]*\).*/\1/p' err.txt | head -n 1)
+    url=$(sed -n 's/^rp: Scene Viewer at \(http[^ ]*\).*/\1/p' "$err" | head -n 1)
     [[ -n $url ]] && break
     if ! kill -0 "$pid" 2>/dev/null; then
       local rc=0
       wait "$pid" || rc=$?
       pid=
-      cat err.txt >&2
+      cat "$err" >&2
       fail "rp-jointmove exited ($rc) before serving its page"
     fi
     sleep 0.1
   done
-  [[ -n $url ]] || { cat err.txt >&2; fail "rp-jointmove printed no Scene Viewer URL"; }
+  [[ -n $url ]] || { cat "$err" >&2; fail "rp-jointmove printed no Scene Viewer URL"; }
   [[ $url == *"token=rp$$" ]] || fail "the printed URL does not carry the token: $url"
   local page
   page=$(curl --silent --show-error --fail --max-time 30 "$url") || fail "cannot fetch $url"
@@ -127,7 +135,7 @@ $page"
   local rc=0
   wait "$pid" || rc=$?
   pid=
-  [[ $rc -eq 130 ]] || { cat err.txt >&2; fail "rp-jointmove ended with status $rc after SIGINT, not 130"; }
+  [[ $rc -eq 130 ]] || { cat "$err" >&2; fail "rp-jointmove ended with status $rc after SIGINT, not 130"; }
   echo "check-relocated: the installed rp-jointmove in $moved, $reach, served $root ($url) and ended with 130 after SIGINT"
 }
 
