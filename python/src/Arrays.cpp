@@ -95,6 +95,33 @@ std::vector<Transform> toTransforms(const py::handle& value, const char* what) {
   return poses;
 }
 
+py::array_t<double> outputArray(const py::object& out, const std::vector<py::ssize_t>& shape,
+                                std::initializer_list<const py::array*> inputs) {
+  if (out.is_none()) return py::array_t<double>(shape);
+  std::ostringstream want;
+  want << '(';
+  for (std::size_t i = 0; i < shape.size(); ++i) want << (i ? ", " : "") << shape[i];
+  want << ')';
+  if (!py::isinstance<py::array>(out))
+    throw py::value_error("out: expected a float64 array of shape " + want.str() + ", got " +
+                          std::string(py::str(py::type::handle_of(out).attr("__name__"))));
+  auto a = py::reinterpret_borrow<py::array>(out);
+  if (!a.dtype().is(py::dtype::of<double>()))
+    throw py::value_error("out: expected dtype float64, got " + std::string(py::str(a.dtype())));
+  bool sameShape = a.ndim() == static_cast<py::ssize_t>(shape.size());
+  for (std::size_t i = 0; sameShape && i < shape.size(); ++i) sameShape = a.shape(static_cast<py::ssize_t>(i)) == shape[i];
+  if (!sameShape) throw py::value_error("out: expected shape " + want.str() + ", got " + shapeOf(a));
+  if (!(a.flags() & py::array::c_style)) throw py::value_error("out: the array must be C-contiguous");
+  if (!a.writeable()) throw py::value_error("out: the array is read-only");
+  const auto* begin = static_cast<const char*>(a.data());
+  const char* end = begin + a.nbytes();
+  for (const py::array* in : inputs) {
+    const auto* b = static_cast<const char*>(in->data());
+    if (b < end && begin < b + in->nbytes()) throw py::value_error("out: the array shares memory with an input");
+  }
+  return py::reinterpret_borrow<py::array_t<double>>(out);
+}
+
 py::array_t<double> fromVector(const Eigen::Ref<const Eigen::VectorXd>& v) {
   py::array_t<double> a(v.size());
   for (Eigen::Index i = 0; i < v.size(); ++i) a.mutable_data()[i] = v(i);

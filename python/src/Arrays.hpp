@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,14 @@ Transform toTransform(const py::handle& value, const char* what);
 /// @throws py::value_error naming `what` (and the row) if it is not N x 4 x 4 real numbers or a
 ///         row is not a rigid transform
 std::vector<Transform> toTransforms(const py::handle& value, const char* what);
+
+/// The array a batched call writes its results into: `out` if the caller gave one (numpy's `out=`
+/// convention: a loop that calls again and again reuses its buffer instead of having a new array
+/// made and its pages first touched each time), else a new array of `shape`.
+/// @throws py::value_error if `out` is not a writable, C-contiguous float64 ndarray of exactly
+///         `shape`, or shares memory with one of `inputs`
+py::array_t<double> outputArray(const py::object& out, const std::vector<py::ssize_t>& shape,
+                                std::initializer_list<const py::array*> inputs);
 
 /// A vector as a new 1-D float64 array.
 py::array_t<double> fromVector(const Eigen::Ref<const Eigen::VectorXd>& v);

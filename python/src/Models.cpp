@@ -273,12 +273,12 @@ void bindModels(py::module_& m) {
       // Batched forms: N x dof arrays in, the GIL released while C++ runs.
       .def(
           "fk_batch",
-          [](const PyModel& p, const py::handle& qs) {
+          [](const PyModel& p, const py::handle& qs, const py::object& out) {
             const int n = p.dof();
             auto q = toMatrix(qs, -1, n, "q");
             const py::ssize_t rows = q.shape(0);
-            py::array_t<double> out({rows, py::ssize_t{4}, py::ssize_t{4}});
-            double* o = out.mutable_data();
+            py::array_t<double> result = outputArray(out, {rows, 4, 4}, {&q});
+            double* o = result.mutable_data();
             {
               py::gil_scoped_release release;
               ManipulatorData data(*p.model);
@@ -288,17 +288,17 @@ void bindModels(py::module_& m) {
                   for (int j = 0; j < 4; ++j) o[(r * 4 + i) * 4 + j] = t(i, j);
               }
             }
-            return out;
+            return result;
           },
-          py::arg("q"), "fk of every row of an N x dof array: N x 4 x 4")
+          py::arg("q"), py::kw_only(), py::arg("out") = py::none(), "fk of every row of an N x dof array: N x 4 x 4")
       .def(
           "link_transforms_batch",
-          [](const PyModel& p, const py::handle& qs) {
+          [](const PyModel& p, const py::handle& qs, const py::object& out) {
             const int n = p.dof();
             auto q = toMatrix(qs, -1, n, "q");
             const py::ssize_t rows = q.shape(0);
-            py::array_t<double> out({rows, py::ssize_t{n}, py::ssize_t{4}, py::ssize_t{4}});
-            double* o = out.mutable_data();
+            py::array_t<double> result = outputArray(out, {rows, n, 4, 4}, {&q});
+            double* o = result.mutable_data();
             {
               py::gil_scoped_release release;
               ManipulatorData data(*p.model);
@@ -310,18 +310,18 @@ void bindModels(py::module_& m) {
                       o[((r * n + k) * 4 + i) * 4 + j] = data.linkTransforms[static_cast<std::size_t>(k)](i, j);
               }
             }
-            return out;
+            return result;
           },
-          py::arg("q"), "link_transforms of every row of an N x dof array: N x dof x 4 x 4")
+          py::arg("q"), py::kw_only(), py::arg("out") = py::none(), "link_transforms of every row of an N x dof array: N x dof x 4 x 4")
       .def(
           "jacobian_batch",
-          [](const PyModel& p, const py::handle& qs, const std::string& frame) {
+          [](const PyModel& p, const py::handle& qs, const std::string& frame, const py::object& out) {
             const int n = p.dof();
             const ReferenceFrame f = frameOf(frame);
             auto q = toMatrix(qs, -1, n, "q");
             const py::ssize_t rows = q.shape(0);
-            py::array_t<double> out({rows, py::ssize_t{6}, py::ssize_t{n}});
-            double* o = out.mutable_data();
+            py::array_t<double> result = outputArray(out, {rows, 6, n}, {&q});
+            double* o = result.mutable_data();
             {
               py::gil_scoped_release release;
               ManipulatorData data(*p.model);
@@ -331,20 +331,20 @@ void bindModels(py::module_& m) {
                   for (int j = 0; j < n; ++j) o[(r * 6 + i) * n + j] = J(i, j);
               }
             }
-            return out;
+            return result;
           },
-          py::arg("q"), py::arg("frame") = "base", "jacobian of every row of an N x dof array: N x 6 x dof")
+          py::arg("q"), py::arg("frame") = "base", py::kw_only(), py::arg("out") = py::none(), "jacobian of every row of an N x dof array: N x 6 x dof")
       .def(
           "rnea_batch",
           [](const PyModel& p, const py::handle& qs, const py::handle& qds, const py::handle& qdds, bool gravity,
-             bool motorInertia, bool friction) {
+             bool motorInertia, bool friction, const py::object& out) {
             const int n = p.dof();
             auto q = toMatrix(qs, -1, n, "q");
             auto qd = toMatrix(qds, -1, n, "qd");
             auto qdd = toMatrix(qdds, -1, n, "qdd");
             const py::ssize_t rows = batchRows({&q, &qd, &qdd});
-            py::array_t<double> out({rows, py::ssize_t{n}});
-            double* o = out.mutable_data();
+            py::array_t<double> result = outputArray(out, {rows, n}, {&q, &qd, &qdd});
+            double* o = result.mutable_data();
             const DynamicsOptions opt = options(gravity, motorInertia, friction);
             {
               py::gil_scoped_release release;
@@ -354,18 +354,18 @@ void bindModels(py::module_& m) {
                 for (int i = 0; i < n; ++i) o[r * n + i] = tau(i);
               }
             }
-            return out;
+            return result;
           },
           py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("gravity") = true, py::arg("motor_inertia") = false,
-          py::arg("friction") = false, "rnea of every row: N x dof")
+          py::arg("friction") = false, py::kw_only(), py::arg("out") = py::none(), "rnea of every row: N x dof")
       .def(
           "gravity_torque_batch",
-          [](const PyModel& p, const py::handle& qs) {
+          [](const PyModel& p, const py::handle& qs, const py::object& out) {
             const int n = p.dof();
             auto q = toMatrix(qs, -1, n, "q");
             const py::ssize_t rows = q.shape(0);
-            py::array_t<double> out({rows, py::ssize_t{n}});
-            double* o = out.mutable_data();
+            py::array_t<double> result = outputArray(out, {rows, n}, {&q});
+            double* o = result.mutable_data();
             {
               py::gil_scoped_release release;
               ManipulatorData data(*p.model);
@@ -375,9 +375,9 @@ void bindModels(py::module_& m) {
                 for (int i = 0; i < n; ++i) o[r * n + i] = tau(i);
               }
             }
-            return out;
+            return result;
           },
-          py::arg("q"), "gravity_torque of every row: N x dof")
+          py::arg("q"), py::kw_only(), py::arg("out") = py::none(), "gravity_torque of every row: N x dof")
       .def(
           "ik_batch",
           [](const PyModel& p, const py::handle& poses, const py::object& seeds, double positionTolerance,
@@ -415,12 +415,12 @@ void bindModels(py::module_& m) {
           "numeric ik of every pose of an N x 4 x 4 array: (solved: N booleans, q: N x dof)")
       .def(
           "crba_batch",
-          [](const PyModel& p, const py::handle& qs, bool motorInertia) {
+          [](const PyModel& p, const py::handle& qs, bool motorInertia, const py::object& out) {
             const int n = p.dof();
             auto q = toMatrix(qs, -1, n, "q");
             const py::ssize_t rows = q.shape(0);
-            py::array_t<double> out({rows, py::ssize_t{n}, py::ssize_t{n}});
-            double* o = out.mutable_data();
+            py::array_t<double> result = outputArray(out, {rows, n, n}, {&q});
+            double* o = result.mutable_data();
             {
               py::gil_scoped_release release;
               ManipulatorData data(*p.model);
@@ -430,20 +430,20 @@ void bindModels(py::module_& m) {
                   for (int j = 0; j < n; ++j) o[(r * n + i) * n + j] = M(i, j);
               }
             }
-            return out;
+            return result;
           },
-          py::arg("q"), py::arg("motor_inertia") = false, "crba of every row: N x dof x dof")
+          py::arg("q"), py::arg("motor_inertia") = false, py::kw_only(), py::arg("out") = py::none(), "crba of every row: N x dof x dof")
       .def(
           "aba_batch",
           [](const PyModel& p, const py::handle& qs, const py::handle& qds, const py::handle& taus, bool gravity,
-             bool motorInertia, bool friction) {
+             bool motorInertia, bool friction, const py::object& out) {
             const int n = p.dof();
             auto q = toMatrix(qs, -1, n, "q");
             auto qd = toMatrix(qds, -1, n, "qd");
             auto tau = toMatrix(taus, -1, n, "tau");
             const py::ssize_t rows = batchRows({&q, &qd, &tau});
-            py::array_t<double> out({rows, py::ssize_t{n}});
-            double* o = out.mutable_data();
+            py::array_t<double> result = outputArray(out, {rows, n}, {&q, &qd, &tau});
+            double* o = result.mutable_data();
             const DynamicsOptions opt = options(gravity, motorInertia, friction);
             {
               py::gil_scoped_release release;
@@ -454,10 +454,10 @@ void bindModels(py::module_& m) {
                 for (int i = 0; i < n; ++i) o[r * n + i] = qdd(i);
               }
             }
-            return out;
+            return result;
           },
           py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("gravity") = true, py::arg("motor_inertia") = false,
-          py::arg("friction") = false, "aba of every row: N x dof");
+          py::arg("friction") = false, py::kw_only(), py::arg("out") = py::none(), "aba of every row: N x dof");
 
   py::class_<PyPuma, PyModel>(m, "Puma560Model",
                               "The Unimation Puma 560 (Corke & Armstrong-Helouvry parameters), with its closed-form "

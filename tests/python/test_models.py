@@ -88,6 +88,52 @@ def test_batched_calls_equal_single_calls(make):
         np.testing.assert_array_equal(links[k], model.link_transforms(Q[k]))
 
 
+@pytest.mark.parametrize("make", MODELS)
+def test_batched_calls_write_into_a_given_out_array(make):
+    """numpy's out= convention: the results land in the caller's array, which is returned; the
+    same values as a new array; a wrong shape, dtype, layout, a read-only array or one that shares
+    memory with an input is a ValueError naming what is wrong, and the array is left as it was."""
+    model = make()
+    n = model.dof
+    rng = np.random.default_rng(12)
+    Q, QD, QDD = random_q(model, rng, 30), rng.uniform(-1, 1, (30, n)), rng.uniform(-1, 1, (30, n))
+    calls = {
+        "fk_batch": (lambda out: model.fk_batch(Q, out=out), (30, 4, 4)),
+        "link_transforms_batch": (lambda out: model.link_transforms_batch(Q, out=out), (30, n, 4, 4)),
+        "jacobian_batch": (lambda out: model.jacobian_batch(Q, "end_effector", out=out), (30, 6, n)),
+        "rnea_batch": (lambda out: model.rnea_batch(Q, QD, QDD, out=out), (30, n)),
+        "gravity_torque_batch": (lambda out: model.gravity_torque_batch(Q, out=out), (30, n)),
+        "crba_batch": (lambda out: model.crba_batch(Q, out=out), (30, n, n)),
+        "aba_batch": (lambda out: model.aba_batch(Q, QD, QDD, out=out), (30, n)),
+    }
+    for name, (call, shape) in calls.items():
+        expected = call(None)
+        assert expected.shape == shape, name
+        out = np.full(shape, np.nan)
+        returned = call(out)
+        assert returned is out, name
+        np.testing.assert_array_equal(out, expected, err_msg=name)
+        wrong = {
+            "shape": np.zeros(shape[:-1] + (shape[-1] + 1,)),
+            "dtype float64": np.zeros(shape, dtype=np.float32),
+            "C-contiguous": np.zeros(shape[::-1]).T,
+            "read-only": np.zeros(shape),
+            "shares memory": None,
+        }
+        wrong["read-only"].flags.writeable = False
+        for what, bad in wrong.items():
+            if bad is None:
+                if name not in ("rnea_batch", "aba_batch"):
+                    continue
+                bad = QD  # an input as the output: its rows would be overwritten while read
+            before = bad.copy()
+            with pytest.raises(ValueError, match=f"out: .*{what}"):
+                call(bad)
+            np.testing.assert_array_equal(bad, before, err_msg=f"{name}: {what}")
+        with pytest.raises(ValueError, match=r"out: expected a float64 array of shape"):
+            call([[0.0]])
+
+
 def test_batched_calls_in_threads_give_the_same_results():
     model = rp.Puma560Model()
     Q = random_q(model, np.random.default_rng(1), 20000)

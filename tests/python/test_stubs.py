@@ -111,10 +111,16 @@ def runtime_parameters(function, name):
 
 
 def stub_parameters(node):
+    """[(parameter, default node or None)], with ("*", None) before keyword-only parameters as
+    pybind11's signatures write them (py::kw_only)."""
     args = node.args
-    assert not args.vararg and not args.kwarg and not args.kwonlyargs and not args.posonlyargs, node.name
+    assert not args.vararg and not args.kwarg and not args.posonlyargs, node.name
     defaults = [None] * (len(args.args) - len(args.defaults)) + list(args.defaults)
-    return [(a.arg, d) for a, d in zip(args.args, defaults)]
+    parameters = [(a.arg, d) for a, d in zip(args.args, defaults)]
+    if args.kwonlyargs:
+        parameters.append(("*", None))
+        parameters += list(zip((a.arg for a in args.kwonlyargs), args.kw_defaults))
+    return parameters
 
 
 def literal(text_or_node):
