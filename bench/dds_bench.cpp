@@ -4,13 +4,17 @@
 // 1. Latency and throughput: a simulated Puma 560 at 1 kHz on the real clock and a Ros2Bridge at
 //    the servo rate (`rate servo`: it publishes each servo cycle's state when the cycle ends). A
 //    plain Cyclone DDS reader in a process of its own (this program with --reader, woken by a
-//    waitset as ddsperf's is) takes every joint_states sample and measures its age: the wall clock
-//    when it is taken minus the sample's stamp, which is the time of the servo cycle that read the
-//    joints. So the latency runs from the servo cycle to the remote reader: the hand-over to the
-//    bridge's thread, the message, DDS and loopback. Median, p99, max, samples per second.
-// 2. ddsperf (Debian's cyclonedds-tools): `ddsperf pong` in one process, `ddsperf ping 1kHz` in
-//    another, for the same time; the one-way latency is half the round trip of its per-second
-//    reports (median of their medians and of their 99th percentiles).
+//    waitset) takes every joint_states sample and measures its age: the wall clock when it is
+//    taken minus the sample's stamp, which is the time at which the servo cycle read the joints
+//    (StateSnapshot::readTime; ros2_control stamps joint states so too). So the latency runs from
+//    the servo cycle's read to the remote reader: the rest of the servo cycle, the hand-over to the
+//    bridge's thread, the message, DDS and loopback. The servo thread's own wake-up latency comes
+//    before the read (rp-latency measures it; docs/realtime.md). Median, p99, max, samples per
+//    second.
+// 2. ddsperf (Debian's cyclonedds-tools): `ddsperf pong waitset` in one process, `ddsperf ping
+//    1kHz waitset` in another, for the same time (woken by waitsets, as our reader); the one-way
+//    latency is half the round trip of its per-second reports (median of their medians and of
+//    their 99th percentiles).
 //    The figure to watch: our median minus ddsperf's one-way median (the goal: < 20 us).
 // 3. Load: four simulated Pumas at 1 kHz, first with no bridge, then with the bridge publishing all
 //    four at the servo rate to a reader in another process: servo overruns (missed deadlines) and
@@ -135,14 +139,18 @@ double field(const std::string& text, const std::string& name) {
   return at == std::string::npos ? -1 : std::atof(text.c_str() + at + name.size() + 1);
 }
 
-// ddsperf ping at 1 kHz against ddsperf pong for `seconds`, on the loopback configuration: the
-// medians of its per-second 50% and 99% round trips, halved [us].
+// ddsperf ping at 1 kHz against ddsperf pong for `seconds`, on the loopback configuration, both
+// taking their samples when a waitset wakes them, as the reader of part 1 does (and a ROS 2
+// executor does); ddsperf's default, a listener called in DDS's receive thread, saves a thread
+// switch on each side (about 5 us one way here). Returns the medians of its per-second 50% and 99%
+// round trips, halved [us].
 std::pair<double, double> ddsperf(int domain, double seconds) {
   setenv("CYCLONEDDS_URI", rp::Ros2Bridge::cycloneConfig({"lo"}).c_str(), 1);
   const std::string d = std::to_string(domain), s = std::to_string(static_cast<int>(seconds + 2));
-  FILE* pong = popen(("ddsperf -i " + d + " -D " + s + " pong 2>&1").c_str(), "r");
+  FILE* pong = popen(("ddsperf -i " + d + " -D " + s + " pong waitset 2>&1").c_str(), "r");
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  FILE* ping = popen(("ddsperf -i " + d + " -D " + std::to_string(static_cast<int>(seconds)) + " ping 1kHz 2>&1").c_str(), "r");
+  FILE* ping =
+      popen(("ddsperf -i " + d + " -D " + std::to_string(static_cast<int>(seconds)) + " ping 1kHz waitset 2>&1").c_str(), "r");
   if (pong == nullptr || ping == nullptr) {
     std::fprintf(stderr, "dds_bench: cannot run ddsperf (Debian's cyclonedds-tools)\n");
     std::exit(1);

@@ -93,13 +93,18 @@ RoboticObject* ObjectManager::findObject(const std::string& name) const {
 }
 
 std::vector<ObjectReference> ObjectManager::getPublishedObjects() const {
-  auto& reg = internal::registry();
   std::vector<ObjectReference> out;
+  getPublishedObjects(out);
+  return out;
+}
+
+void ObjectManager::getPublishedObjects(std::vector<ObjectReference>& out) const {
+  out.clear();  // the references held from the last call go before the lock is taken
+  auto& reg = internal::registry();
   std::lock_guard<std::recursive_mutex> lock(reg.mutex);  // keeps every listed object's base alive
   out.reserve(reg.objects.size());
   for (RoboticObject* o : reg.objects)
     if (o->tryReference()) out.push_back(ObjectReference(o));
-  return out;
 }
 
 ObjectReference ObjectManager::findPublishedObject(const std::string& name) const {

@@ -746,6 +746,8 @@ void DefaultManipulator::exitControl() {
 
 void DefaultManipulator::readInputs() {
   const double t = getTime();
+  // When the joints are read (StateSnapshot::readTime): a clock read, no system call (vDSO).
+  readTime_ = getClock().isSimulated() ? t : getClock().getTime();
   const double dt = getPeriod();
   const int n = model_->getNumberOfJoints();
 
@@ -1059,6 +1061,7 @@ void DefaultManipulator::powerOffNow() noexcept {
 void DefaultManipulator::publish() {
   PublishedState s;
   s.time = getTime();
+  s.readTime = readTime_;
   s.n = static_cast<int>(q_.size());
   s.power = power_;
   s.missed = missedCycles_;
@@ -1139,6 +1142,7 @@ bool DefaultManipulator::getStateSnapshot(StateSnapshot& snapshot) const {
   PublishedState s = initial_;
   published_.read(s);
   snapshot.time = s.time;
+  snapshot.readTime = s.readTime;
   snapshot.size = 3 * s.n + 3;
   for (int i = 0; i < s.n; ++i) {
     snapshot.values[i] = s.q[i];

@@ -93,6 +93,7 @@ struct ArmEntry {
   std::string name;      // object name
   std::string rosName;   // the name in frames, joints and topics
   std::vector<std::string> jointNames;
+  std::vector<char*> jointNamePointers;  // into jointNames, as a JointState's name sequence wants them
   std::vector<std::string> frameNames;  // link1..n, tool
   std::vector<Transform> frameFromModel;  // frame k = model link frame k * this (URDF link frames)
   std::unique_ptr<ManipulatorData> data;
@@ -118,6 +119,10 @@ struct Ros2Bridge::Impl {
   std::map<std::string, dds_entity_t> topics;
   dds_entity_t jointStates = 0, tf = 0, tfStatic = 0, description = 0;
   std::map<const RoboticObject*, ArmEntry> arms;
+  // Reused by every cycle (at the servo rate up to 1000 a second): once they have grown to the
+  // number of objects and frames, a cycle allocates nothing for them.
+  std::vector<ObjectReference> published;  // empty between cycles: no arm is kept from its destruction
+  std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms;
   std::chrono::steady_clock::time_point lastFull{};  // the last full cycle (see cycle())
   std::atomic<std::uint64_t> cycles{0}, jointStatesWritten{0}, tfWritten{0}, descriptions{0}, states{0}, failures{0};
   std::atomic<std::size_t> manipulators{0};
@@ -450,12 +455,14 @@ void Ros2Bridge::Impl::writeSample(const ManipulatorModel& model, ArmEntry& e, c
                                    const JointVector& tau, const builtin_interfaces_msg_dds__Time_& stamp,
                                    std::vector<geometry_msgs_msg_dds__TransformStamped_>& transforms) {
   const int n = model.getNumberOfJoints();
-  std::vector<char*> names(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) names[static_cast<std::size_t>(i)] = const_cast<char*>(e.jointNames[static_cast<std::size_t>(i)].c_str());
+  if (e.jointNamePointers.size() != e.jointNames.size()) {  // once, where the entry stays (arms' map)
+    e.jointNamePointers.clear();
+    for (const std::string& name : e.jointNames) e.jointNamePointers.push_back(const_cast<char*>(name.c_str()));
+  }
   sensor_msgs_msg_dds__JointState_ js{};
   js.header.stamp = stamp;
   js.header.frame_id = const_cast<char*>("");
-  js.name._buffer = names.data();
+  js.name._buffer = e.jointNamePointers.data();
   js.position._buffer = const_cast<double*>(q.data());  // dds_write only reads
   js.velocity._buffer = const_cast<double*>(qd.data());
   js.effort._buffer = const_cast<double*>(tau.data());
@@ -484,13 +491,18 @@ void Ros2Bridge::Impl::cycle() {
   const auto started = std::chrono::steady_clock::now();
   const bool full = !servo || started - lastFull >= std::chrono::milliseconds(20);
   if (full) lastFull = started;
-  std::vector<ObjectReference> published = ObjectManager().getPublishedObjects();
+  ObjectManager().getPublishedObjects(published);
+  // The references go when the cycle ends, however it ends: an arm's destruction never waits for
+  // the bridge's next cycle.
+  struct Release {
+    std::vector<ObjectReference>& references;
+    ~Release() { references.clear(); }
+  } release{published};
   if (full)
     for (auto& [o, e] : arms) e.seen = false;
   bool changed = false;
   const builtin_interfaces_msg_dds__Time_ publishedAt = now();
-  std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms;
-  std::vector<std::string> frameIds;  // keeps the child frame names alive
+  transforms.clear();
   std::size_t count = 0;
   for (const ObjectReference& r : published) {
     auto* m = dynamic_cast<Manipulator*>(r.get());
@@ -528,7 +540,9 @@ void Ros2Bridge::Impl::cycle() {
         tau(i) = snap.values[2 * n + i];
       }
       power = snap.values[3 * n] != 0;
-      stamp = cycleStamp(*m, snap.time, publishedAt);
+      // Stamped with the time the cycle read the joints, as ros2_control's joint_state_broadcaster
+      // stamps with the time of the controller manager's read.
+      stamp = cycleStamp(*m, snap.readTime > 0 ? snap.readTime : snap.time, publishedAt);
     } else {
       q = m->getJointPosition();
       qd = m->getJointVelocity();

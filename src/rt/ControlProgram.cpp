@@ -762,6 +762,9 @@ struct ControlProgram::Executor {
       } else {
         done = phases(*l, 0, 1, woke);
       }
+      // The programs' state of this cycle is published (in their phases): threads that publish
+      // each cycle's state (CycleSignal.hpp) go now, not after the bookkeeping below.
+      internal::cycleEnded();
       // Bookkeeping: logs, statistics, cycle limits.
       const bool overrun = !simulated && done > deadline + period;
       const Impl* slowest = nullptr;
@@ -792,7 +795,6 @@ struct ControlProgram::Executor {
         overrunNs.store(slowest->cycleNs, std::memory_order_relaxed);
       }
       internal::currentLoop = nullptr;
-      internal::cycleEnded();  // for threads that publish each cycle's state (CycleSignal.hpp)
     }
     release();
     return live;

@@ -1,7 +1,8 @@
 #pragma once
 // The end of every executor's cycle as an event for threads outside the servo loops (the ROS 2
 // bridge publishing at the servo rate): a process-wide count of cycles ended, and a futex on it.
-// The executors call cycleEnded() after each cycle's bookkeeping; it costs an atomic increment,
+// The executors call cycleEnded() after each cycle's phases, before its bookkeeping (logs,
+// statistics), so that a waiting thread goes as soon as the state is published; it costs an atomic increment,
 // plus one FUTEX_WAKE system call (which never blocks) only while some thread waits.
 
 #include <cstdint>

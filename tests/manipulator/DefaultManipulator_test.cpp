@@ -928,6 +928,44 @@ class AllocationProbe : public ServoControl {
   std::atomic<std::size_t> total_{0};  // allocations_, published for the test thread
 };
 
+// StateSnapshot::readTime, which the ROS 2 bridge stamps joint states with: on a simulated clock
+// the cycle's time; on a real clock later than the cycle's scheduled time (the loop wakes at or
+// after it, then reads) and never later than the moment the snapshot is taken.
+TEST_F(ManipulatorTest, TheStateSnapshotSaysWhenTheCycleReadTheJoints) {
+  {
+    Puma560 puma("puma");
+    ASSERT_TRUE(puma.waitForCycles(3));
+    StateSnapshot s;
+    ASSERT_TRUE(puma.getStateSnapshot(s));
+    EXPECT_GT(s.time, 0);
+    EXPECT_EQ(s.readTime, s.time);
+  }
+  RoboticPlatform::useRealClock();
+  {
+    Puma560 puma("puma");
+    ASSERT_TRUE(puma.waitForCycles(3));
+    const Clock& clock = puma.getControlProgram()->getClock();
+    ASSERT_FALSE(clock.isSimulated());
+    double lastTime = -1;
+    int cycles = 0;
+    for (int i = 0; i < 200 && cycles < 20; ++i) {
+      StateSnapshot s;
+      ASSERT_TRUE(puma.getStateSnapshot(s));
+      const double now = clock.getTime();
+      if (s.time == lastTime) {
+        std::this_thread::sleep_for(std::chrono::microseconds(300));
+        continue;
+      }
+      lastTime = s.time;
+      ++cycles;
+      EXPECT_GT(s.readTime, s.time) << "read before the cycle's scheduled time";
+      EXPECT_LE(s.readTime, now) << "read after the snapshot was taken";
+    }
+    EXPECT_GE(cycles, 20);
+  }
+  simClock();  // back to the simulated clock for the other tests
+}
+
 TEST_F(ManipulatorTest, TheServoCycleDoesNotAllocate) {
   Puma560 puma;
   JointVector target = puma.getModel().getHomePosition();

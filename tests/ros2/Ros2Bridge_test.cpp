@@ -348,8 +348,9 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
 }
 
 // At the servo rate (`rate servo`) the bridge publishes every servo cycle as it ends: each sample
-// is a cycle not published before, stamped with that cycle's time, so the stamps are whole servo
-// periods apart and most are one period apart (at a set rate of 100 Hz they are ten).
+// is a cycle not published before, stamped with the time that cycle read the joints, so the stamps
+// are whole servo periods apart give or take the servo thread's wake-up jitter, and most are one
+// period apart (at a set rate of 100 Hz they are ten).
 TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithItsTime) {
   Puma560 puma("puma");
   options_.rate = Ros2BridgeOptions::kServoRate;
@@ -376,10 +377,11 @@ TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithIts
   // stamped when it was published.
   for (std::size_t k = 2; k < stamps.size(); ++k) {
     const double periods = (stamps[k] - stamps[k - 1]) / period;
-    // To within a tenth of a period: the stamp is the wall clock minus the snapshot's age, two
-    // clocks read one after the other (microseconds apart, more when the thread is preempted).
-    EXPECT_GE(periods, 0.9) << "sample " << k << ": not a later cycle";
-    EXPECT_NEAR(periods, std::round(periods), 0.1) << "sample " << k << ": not a cycle's time";
+    // Each cycle reads the joints when its thread wakes, some microseconds after the cycle's
+    // scheduled time (hundreds under ASan with other tests running): to within a third of a
+    // period a whole number of periods, and never the same cycle twice (a gap near 0).
+    EXPECT_GE(periods, 0.6) << "sample " << k << ": not a later cycle";
+    EXPECT_NEAR(periods, std::round(periods), 0.34) << "sample " << k << ": not a cycle's time";
     gaps.push_back(periods);
   }
   std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());

@@ -57,6 +57,11 @@ class ObjectManager {
   /// (the Scene Viewer) may call its functions. Objects not yet published, or withdrawn, are left
   /// out. Real-time safe: no.
   std::vector<ObjectReference> getPublishedObjects() const;
+  /// The same into `out` (emptied first), reusing its capacity: a thread that lists the objects
+  /// again and again (the ROS 2 bridge after every servo cycle) allocates only when their number
+  /// grows. Real-time safe: no (it takes the registry's lock).
+  /// @param[out] out  references to every published object, in creation order
+  void getPublishedObjects(std::vector<ObjectReference>& out) const;
   /// A reference to the published object called `name`; empty if there is none (or it is not
   /// published). Real-time safe: no.
   /// @param[in] name  object name
