@@ -236,26 +236,44 @@ inline void motionSubspace(const ManipulatorModel& model, const ManipulatorData&
 // frame T (column-major 4 x 4). Io = R Ic R^T + m (|c|^2 1 - c c^T) is symmetric: only its six
 // distinct entries (xx, yy, zz, xy, xz, yz) are computed, from R Ic and six dot products, in plain
 // scalars (Eigen's products on the 3 x 3 corner of a 4 x 4 matrix took twice the instructions).
-[[gnu::always_inline]] inline void linkInertia(const LinkParameters& l, const Transform& T, double* h, double* Io) {
+// With the inertia's Cholesky factor L (ManipulatorModel::getInertiaFactor(): Ic = L L^T),
+// R Ic R^T = G G^T with G = R L: 18 + 18 multiplications instead of 27 + 21.
+[[gnu::always_inline]] inline void linkInertia(const ManipulatorModel& model, int i, const Transform& T, double* h,
+                                               double* Io) {
+  const LinkParameters& l = model.getLink(i);
   // Columns of four (the last row of T is 0 0 0 1) so that Eigen works on pairs of numbers.
-  using M43 = Eigen::Matrix<double, 4, 3>;
   const auto R4 = T.leftCols<3>();
-  M43 A;
-  A.noalias() = R4 * l.inertia;                                // R Ic
-  // R Ic R^T: rows 0 and 1 (a pair each column), and the last diagonal entry.
-  Eigen::Matrix<double, 2, 3> J;
-  J.noalias() = A.topRows<2>() * T.topLeftCorner<3, 3>().transpose();
-  const double J22 = A.row(2).dot(T.block<1, 3>(2, 0));
+  double J00, J11, J22, J01, J02, J12;  // R Ic R^T
+  if (const Eigen::Matrix3d* L = model.getInertiaFactor(i)) {
+    const double* f = L->data();  // column-major, lower: f[0] f[1] f[2] / f[4] f[5] / f[8]
+    const Eigen::Vector4d g0 = f[0] * T.col(0) + f[1] * T.col(1) + f[2] * T.col(2);
+    const Eigen::Vector4d g1 = f[4] * T.col(1) + f[5] * T.col(2);
+    const Eigen::Vector4d g2 = f[8] * T.col(2);
+    const Eigen::Vector4d d = g0.cwiseProduct(g0) + g1.cwiseProduct(g1) + g2.cwiseProduct(g2);
+    J00 = d(0), J11 = d(1), J22 = d(2);
+    J01 = g0(0) * g0(1) + g1(0) * g1(1) + g2(0) * g2(1);
+    J02 = g0(0) * g0(2) + g1(0) * g1(2) + g2(0) * g2(2);
+    J12 = g0(1) * g0(2) + g1(1) * g1(2) + g2(1) * g2(2);
+  } else {
+    using M43 = Eigen::Matrix<double, 4, 3>;
+    M43 A;
+    A.noalias() = R4 * l.inertia;  // R Ic
+    // R Ic R^T: rows 0 and 1 (a pair each column), and the last diagonal entry.
+    Eigen::Matrix<double, 2, 3> J;
+    J.noalias() = A.topRows<2>() * T.topLeftCorner<3, 3>().transpose();
+    J00 = J(0, 0), J11 = J(1, 1), J01 = J(0, 1), J02 = J(0, 2), J12 = J(1, 2);
+    J22 = A.row(2).dot(T.block<1, 3>(2, 0));
+  }
   const Eigen::Vector4d c = R4 * l.com + T.col(3);        // c(3) = 1
   const double m = l.mass;
   for (int a = 0; a < 3; ++a) h[a] = m * c(a);
   const double hc = h[0] * c(0) + h[1] * c(1) + h[2] * c(2);
-  Io[0] = J(0, 0) + hc - h[0] * c(0);
-  Io[1] = J(1, 1) + hc - h[1] * c(1);
+  Io[0] = J00 + hc - h[0] * c(0);
+  Io[1] = J11 + hc - h[1] * c(1);
   Io[2] = J22 + hc - h[2] * c(2);
-  Io[3] = J(0, 1) - h[0] * c(1);
-  Io[4] = J(0, 2) - h[0] * c(2);
-  Io[5] = J(1, 2) - h[1] * c(2);
+  Io[3] = J01 - h[0] * c(1);
+  Io[4] = J02 - h[0] * c(2);
+  Io[5] = J12 - h[1] * c(2);
 }
 
 // The six entries (xx, yy, zz, xy, xz, yz) as a symmetric 3 x 3 matrix.
@@ -266,7 +284,7 @@ void worldLinkInertias(const ManipulatorModel& model, ManipulatorData& data) {
     const auto k = static_cast<std::size_t>(i);
     motionSubspace(model, data, i, data.motionSubspace[k].data());
     double Io[6];
-    linkInertia(model.getLink(i), data.linkTransforms[k], data.massMoment[k].data(), Io);
+    linkInertia(model, i, data.linkTransforms[k], data.massMoment[k].data(), Io);
     symmetric(Io, data.originInertia[k]);
   }
 }
@@ -303,7 +321,7 @@ void compositeRigidBody(const ManipulatorModel& model, ManipulatorData& data, bo
     const auto k = static_cast<std::size_t>(j);
     const LinkParameters& l = model.getLink(j);
     double h[3], Io[6];
-    linkInertia(l, data.linkTransforms[k], h, Io);
+    linkInertia(model, j, data.linkTransforms[k], h, Io);
     if constexpr (keepLinks) {
       data.massMoment[k] << h[0], h[1], h[2];
       symmetric(Io, data.originInertia[k]);

@@ -1,6 +1,8 @@
 // ManipulatorModel and ManipulatorData (rp/model/ManipulatorModel.hpp, ManipulatorData.hpp).
 #include "rp/model/ManipulatorModel.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -117,6 +119,18 @@ ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters>
     home_(i) = std::clamp(0.0, l.positionMin, l.positionMax);
     cosAlpha_(i) = std::cos(l.alpha);
     sinAlpha_(i) = std::sin(l.alpha);
+    // The factor is used only where it gives the inertia back to rounding: a positive definite
+    // tensor (Eigen's LLT does not check symmetry; the lower triangle is the one it reads).
+    const Eigen::LLT<Eigen::Matrix3d> llt(l.inertia);
+    Eigen::Matrix3d L = Eigen::Matrix3d::Zero();
+    bool valid = llt.info() == Eigen::Success;
+    if (valid) {
+      L = llt.matrixL();
+      const double scale = l.inertia.cwiseAbs().maxCoeff();
+      valid = L.allFinite() && (L * L.transpose() - l.inertia).cwiseAbs().maxCoeff() <= 1e-14 * scale;
+    }
+    inertiaFactors_.push_back(L);
+    inertiaFactorValid_.push_back(valid);
   }
 }
 

@@ -79,6 +79,52 @@ TEST(Dynamics, NewtonEulerEqualsMassMatrixPlusBiasTerms) {
   }
 }
 
+// The mass matrix uses each link's Cholesky factor where there is one: the factor gives the
+// inertia back, and a tensor that is only semidefinite (the Puma's first link, a point mass), not
+// symmetric or not finite has none, so the plain form serves it. Both forms give the same matrix.
+TEST(Dynamics, InertiaFactorsAreCholeskyFactorsWhereTheInertiaIsPositiveDefinite) {
+  const Puma560Model puma;
+  EXPECT_EQ(puma.getInertiaFactor(0), nullptr) << "the Puma's link 1: Ixx = Izz = 0";
+  const WAM7Model wam;
+  for (const ManipulatorModel* m : {static_cast<const ManipulatorModel*>(&puma), static_cast<const ManipulatorModel*>(&wam)}) {
+    for (int i = 0; i < m->getNumberOfJoints(); ++i) {
+      const Eigen::Matrix3d& I = m->getLink(i).inertia;
+      const Eigen::Matrix3d* L = m->getInertiaFactor(i);
+      if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I).eigenvalues().minCoeff() > 1e-12 * I.norm()) {
+        ASSERT_NE(L, nullptr) << m->getName() << " link " << i + 1;
+        EXPECT_TRUE(L->isLowerTriangular());
+        EXPECT_LT((*L * L->transpose() - I).norm(), 1e-15 * I.norm()) << m->getName() << " link " << i + 1;
+      } else {
+        EXPECT_EQ(L, nullptr) << m->getName() << " link " << i + 1;
+      }
+    }
+  }
+  // The same links, a point mass at the end and an inertia that is not symmetric.
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < wam.getNumberOfJoints(); ++i) links.push_back(wam.getLink(i));
+  links[6].inertia.setZero();
+  links[5].inertia(0, 1) += 1e-3;
+  const ManipulatorModel odd("odd", links, wam.getBaseTransform(), wam.getToolTransform(), wam.getGravity());
+  EXPECT_EQ(odd.getInertiaFactor(6), nullptr) << "a point mass";
+  EXPECT_EQ(odd.getInertiaFactor(5), nullptr) << "not symmetric";
+  ASSERT_NE(odd.getInertiaFactor(4), nullptr);
+  // A model that mixes both forms (the point mass plain, the other links factored): its mass
+  // matrix against Newton-Euler with gravity and velocity off.
+  links[5].inertia = wam.getLink(5).inertia;
+  const ManipulatorModel pointMass("point_mass", links, wam.getBaseTransform(), wam.getToolTransform(), wam.getGravity());
+  ManipulatorData a(pointMass), b(pointMass);
+  std::mt19937_64 rng(3);
+  for (int trial = 0; trial < 50; ++trial) {
+    const JointVector q = randomJoints(pointMass, rng), qdd = randomJoints(pointMass, rng);
+    const JointMatrix M = massMatrix(pointMass, a, q);
+    DynamicsOptions opt;
+    opt.gravity = false;
+    const JointVector tau = inverseDynamics(pointMass, b, q, JointVector::Zero(7), qdd, opt);
+    const JointVector Mq = M * qdd;
+    for (int i = 0; i < 7; ++i) EXPECT_NEAR(Mq(i), tau(i), 1e-12 * (1 + std::abs(tau(i))));
+  }
+}
+
 TEST(Dynamics, ForwardDynamicsInvertsInverseDynamics) {
   std::mt19937_64 rng(2);
   for (auto& robot : robots()) {

@@ -212,6 +212,14 @@ class ManipulatorModel {
   const JointVector& getCosAlpha() const { return cosAlpha_; }
   /// \f$\sin\alpha_i\f$ of every link (precomputed for the algorithms). Real-time safe: yes.
   const JointVector& getSinAlpha() const { return sinAlpha_; }
+  /// Link `i`'s rotational inertia about its centre of mass as \f$L L^T\f$, L lower triangular
+  /// (its Cholesky factor, precomputed for the mass matrix: \f$R I_c R^T = (R L)(R L)^T\f$ costs
+  /// half the products of the plain form), or nullptr where the inertia is not positive definite
+  /// (a point mass, a massless link). Real-time safe: yes.
+  const Eigen::Matrix3d* getInertiaFactor(int i) const {
+    const auto k = static_cast<std::size_t>(i);
+    return inertiaFactorValid_[k] ? &inertiaFactors_[k] : nullptr;
+  }
 
   /// A good resting configuration (the model's home or ready pose) [rad]. Real-time safe: yes.
   const JointVector& getHomePosition() const { return home_; }
@@ -246,6 +254,8 @@ class ManipulatorModel {
   std::vector<Transform> placements_;
   std::vector<PlacementAxes> placementAxes_;
   JointVector qmin_, qmax_, vmax_, amax_, jmax_, taumax_, armature_, home_, cosAlpha_, sinAlpha_;
+  std::vector<Eigen::Matrix3d> inertiaFactors_;  // Cholesky factors (getInertiaFactor())
+  std::vector<bool> inertiaFactorValid_;
   std::shared_ptr<const ManipulatorModel> chain_;  // with mimic joints only
   std::vector<JointCoupling> coupling_;
   std::vector<int> chainIndex_;
