@@ -3,14 +3,9 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
-#include <unistd.h>
 
 #include "Arrays.hpp"
 #include "Bindings.hpp"
@@ -48,29 +43,13 @@ std::shared_ptr<ManipulatorModel> makeWam(int dof, const Transform& base, const 
   throw py::value_error("WAMModel: dof must be 4 or 7, got " + std::to_string(dof));
 }
 
-// A URDF given as a path, or as the XML text itself (written to a private temporary file that
-// error messages call "<string>").
+// A URDF given as a path, or as the XML text itself (error messages then call it "<string>").
 std::shared_ptr<ManipulatorModel> makeUrdf(const std::string& source, const std::string& tip, bool requireDynamics) {
   UrdfOptions options;
   options.tip = tip;
   options.requireDynamics = requireDynamics;
   if (source.find('<') == std::string::npos) return std::shared_ptr<ManipulatorModel>(loadUrdf(source, options));
-  char name[] = "/tmp/rp-urdf-XXXXXX";
-  const int fd = ::mkstemp(name);
-  if (fd < 0) throw std::runtime_error("UrdfModel: cannot create a temporary file for the URDF text");
-  ::close(fd);
-  struct Remove {
-    const char* path;
-    ~Remove() { std::filesystem::remove(path); }
-  } remove{name};
-  std::ofstream(name) << source;
-  try {
-    return std::shared_ptr<ManipulatorModel>(loadUrdf(name, options));
-  } catch (const UrdfError& e) {
-    std::string message = e.what();
-    for (std::size_t at; (at = message.find(name)) != std::string::npos;) message.replace(at, std::strlen(name), "<string>");
-    throw UrdfError(message);
-  }
+  return std::shared_ptr<ManipulatorModel>(loadUrdfString(source, options));
 }
 
 const char* statusName(IkStatus s) {

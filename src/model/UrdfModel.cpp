@@ -20,6 +20,7 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <numbers>
 #include <unordered_map>
 #include <unordered_set>
@@ -628,7 +629,16 @@ struct UnlinkOnExit {
 }  // namespace
 
 std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options) {
-  const std::string text = readUrdfFile(fileName);
+  return loadUrdfString(readUrdfFile(fileName), options, fileName);
+}
+
+std::unique_ptr<ManipulatorModel> loadUrdfString(const std::string& text, const UrdfOptions& options,
+                                                 const std::string& fileName) {
+  if (!(std::isfinite(options.velocityLimitScale) && options.velocityLimitScale > 0)) {
+    std::ostringstream value;
+    value << options.velocityLimitScale;
+    throw UrdfOptionError(fileName, "velocityLimitScale", "must be a positive number, not " + value.str());
+  }
   checkNesting(text, fileName);
   checkDocument(text, fileName);
   std::vector<std::string> urdfdomErrors;
@@ -813,7 +823,7 @@ std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const Ur
       }
     }
     if (j->limits && j->limits->effort > 0) l.torqueLimit = j->limits->effort;
-    if (j->limits && j->limits->velocity > 0) l.velocityLimit = j->limits->velocity;
+    if (j->limits && j->limits->velocity > 0) l.velocityLimit = j->limits->velocity * options.velocityLimitScale;
     if (j->dynamics) {
       l.viscousFriction = j->dynamics->damping;
       l.coulombFrictionPositive = j->dynamics->friction;

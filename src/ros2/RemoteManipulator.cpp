@@ -1,8 +1,6 @@
 #include "rp/ros2/RemoteManipulator.hpp"
 
 #include <dds/dds.h>
-#include <stdlib.h>  // mkstemps
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -13,7 +11,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
-#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -60,58 +57,6 @@ builtin_interfaces_msg_dds__Duration_ duration(double s) {
     d.nanosec -= 1000000000u;
   }
   return d;
-}
-
-// `urdf` with the velocity="..." attribute of every <limit> element multiplied by `factor`.
-std::string scaleVelocityLimits(const std::string& urdf, double factor) {
-  std::string out;
-  out.reserve(urdf.size());
-  std::size_t at = 0;
-  for (std::size_t tag; (tag = urdf.find("<limit", at)) != std::string::npos;) {
-    const std::size_t end = urdf.find('>', tag);
-    if (end == std::string::npos) break;
-    const std::size_t v = urdf.find("velocity=\"", tag);
-    if (v == std::string::npos || v > end) {
-      out.append(urdf, at, end + 1 - at);
-      at = end + 1;
-      continue;
-    }
-    const std::size_t start = v + 10, stop = urdf.find('"', start);
-    if (stop == std::string::npos || stop > end) break;
-    char* parsed = nullptr;
-    const double value = std::strtod(urdf.c_str() + start, &parsed);
-    out.append(urdf, at, start - at);
-    if (parsed == urdf.c_str() + stop && std::isfinite(value)) {
-      std::ostringstream x;
-      x.precision(17);
-      x << value * factor;
-      out += x.str();
-    } else {
-      out.append(urdf, start, stop - start);  // not a number: loadUrdf() says so
-    }
-    at = stop;
-  }
-  out.append(urdf, at, std::string::npos);
-  return out;
-}
-
-// The model of a URDF text (loadUrdf() reads files): written to a temporary file first.
-std::unique_ptr<ManipulatorModel> modelOfUrdf(const std::string& urdf) {
-  const char* dir = std::getenv("TMPDIR");
-  std::string path = std::string(dir != nullptr && *dir != '\0' ? dir : "/tmp") + "/rp-remote-XXXXXX.urdf";
-  const int fd = mkstemps(path.data(), 5);
-  if (fd < 0) throw std::runtime_error("cannot write a temporary file in " + path);
-  const bool written = ::write(fd, urdf.data(), urdf.size()) == static_cast<ssize_t>(urdf.size());
-  ::close(fd);
-  try {
-    if (!written) throw std::runtime_error("cannot write " + path);
-    auto model = loadUrdf(path);
-    ::unlink(path.c_str());
-    return model;
-  } catch (...) {
-    ::unlink(path.c_str());
-    throw;
-  }
 }
 
 }  // namespace
@@ -431,7 +376,9 @@ void RemoteManipulator::connect() {
                                std::to_string(o.connectTimeout) + " s: is the remote arm's process running with a Ros2Bridge?");
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  d.model = modelOfUrdf(scaleVelocityLimits(urdf, kVelocityReserve));
+  UrdfOptions urdfOptions;
+  urdfOptions.velocityLimitScale = kVelocityReserve;
+  d.model = loadUrdfString(urdf, urdfOptions, Ros2Bridge::ddsTopicName(d.nameSpace, d.object + "/robot_description"));
   d.n = d.model->getNumberOfJoints();
   const std::string prefix = d.object + "_";
   for (int i = 0; i < d.n; ++i) {

@@ -17,6 +17,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <random>
@@ -258,6 +260,67 @@ TEST(UrdfModel, BadFilesGiveClearErrors) {
   dynamics.requireDynamics = true;
   EXPECT_NE(message(kData + "/no_inertia.urdf", dynamics).find("link 'b' has no inertial data"), std::string::npos);
   EXPECT_EQ(message(kData + "/no_inertia.urdf"), "no error") << "kinematics only is fine";
+}
+
+// A URDF given as text (a robot_description from the network): the same model as from the file,
+// the same errors with the given source name in place of the file's, and the velocity limits
+// scaled where UrdfOptions::velocityLimitScale says (limits the file leaves out keep the default).
+TEST(UrdfModel, TextLoadsAsTheFileDoesAndVelocityLimitsScale) {
+  auto read = [](const std::string& file) {
+    std::ifstream in(file);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string text = read(kData + "/test_arm.urdf");
+  ASSERT_FALSE(text.empty());
+  const auto fromFile = loadUrdf(kData + "/test_arm.urdf");
+  const auto fromText = loadUrdfString(text);
+  ASSERT_EQ(fromText->getNumberOfJoints(), fromFile->getNumberOfJoints());
+  ManipulatorData a(*fromFile), b(*fromText);
+  JointVector q(fromFile->getNumberOfJoints());
+  for (int i = 0; i < q.size(); ++i) q(i) = 0.3 * (i + 1) - 0.7;
+  EXPECT_TRUE(forwardKinematics(*fromText, b, q).isApprox(forwardKinematics(*fromFile, a, q), 0));
+  EXPECT_EQ(fromText->getVelocityLimit(), fromFile->getVelocityLimit());
+
+  UrdfOptions slower;
+  slower.velocityLimitScale = 0.8;
+  const auto scaled = loadUrdfString(text, slower);
+  const urdf::ModelInterfaceSharedPtr robot = parse(kData + "/test_arm.urdf");
+  int given = 0;
+  for (int i = 0; i < scaled->getNumberOfJoints(); ++i) {
+    const urdf::JointConstSharedPtr j = robot->getJoint(scaled->getJointName(i));
+    ASSERT_TRUE(j);
+    if (j->limits && j->limits->velocity > 0) {
+      ++given;
+      EXPECT_EQ(scaled->getVelocityLimit()(i), 0.8 * j->limits->velocity) << scaled->getJointName(i);
+    } else {  // the default, unscaled (j4 is continuous, without a velocity)
+      EXPECT_EQ(scaled->getVelocityLimit()(i), fromFile->getVelocityLimit()(i)) << scaled->getJointName(i);
+    }
+  }
+  EXPECT_GE(given, 4);
+  EXPECT_LT(given, scaled->getNumberOfJoints()) << "both cases are covered";
+
+  auto message = [](const std::string& text, const UrdfOptions& o, const std::string& source) -> std::string {
+    try {
+      loadUrdfString(text, o, source);
+    } catch (const UrdfError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(message(read(kData + "/bad_xml.urdf"), UrdfOptions(), "<string>"),
+            "<string>:3:1: not a valid URDF document: malformed XML (Error reading end tag)");
+  EXPECT_EQ(message(text, slower, "rt/cell/puma/robot_description"), "no error");
+  for (const double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    UrdfOptions o;
+    o.velocityLimitScale = bad;
+    try {
+      loadUrdfString(text, o, "desc");
+      ADD_FAILURE() << "velocityLimitScale " << bad << " taken";
+    } catch (const UrdfOptionError& e) {
+      EXPECT_EQ(e.option(), "velocityLimitScale");
+      EXPECT_EQ(std::string(e.what()).rfind("desc: UrdfOptions::velocityLimitScale: must be a positive number", 0), 0u) << e.what();
+    }
+  }
 }
 
 // Issue 20: a branch that carries only fixed frames (a camera, tool0, a base frame) is no branch:

@@ -64,6 +64,11 @@ struct UrdfOptions {
   /// Whether offChainPositions are in rp.cfg's units: degrees for revolute and continuous joints,
   /// millimetres for prismatic ones (UrdfManipulator's `offChainPositions` setting).
   bool offChainInDegreesAndMillimetres = false;
+  /// The joints' velocity limits are the `<limit velocity>` of the file times this (a positive,
+  /// finite number; UrdfOptionError otherwise): a client that plans for an arm it does not drive
+  /// itself (RemoteManipulator) keeps a reserve for the arm's own controller. Velocities the file
+  /// does not give keep the ManipulatorModel default.
+  double velocityLimitScale = 1.0;
 };
 
 /// Loads the serial chain from the URDF root link to a tip link as a ManipulatorModel.
@@ -101,5 +106,16 @@ struct UrdfOptions {
 ///         data; UrdfOptionError (a UrdfError) for a bad UrdfOptions::offChainPositions entry
 /// Real-time safe: no.
 std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options = UrdfOptions());
+
+/// The same as loadUrdf() for a URDF document given as text (a `robot_description` received over
+/// the network, a string built in a program): the same checks and the same errors, in which
+/// `sourceName` stands where loadUrdf() names the file (`<string>:LINE:COLUMN: ...`).
+/// @param[in] text        the URDF document
+/// @param[in] options     as loadUrdf()'s
+/// @param[in] sourceName  what error messages call the document
+/// @throws UrdfError as loadUrdf() (except for reading a file)
+/// Real-time safe: no.
+std::unique_ptr<ManipulatorModel> loadUrdfString(const std::string& text, const UrdfOptions& options = UrdfOptions(),
+                                                 const std::string& sourceName = "<string>");
 
 }  // namespace rp
