@@ -85,15 +85,6 @@ struct Child {
   }
 };
 
-std::vector<double> numbersAfter(const std::string& text, const std::string& word) {
-  std::vector<double> v;
-  const std::size_t at = text.find(word);
-  if (at == std::string::npos) return v;
-  std::istringstream in(text.substr(at + word.size()));
-  for (double x; in >> x;) v.push_back(x);
-  return v;
-}
-
 class RemoteManipulatorTest : public Ros2Fixture {
  protected:
   void SetUp() override {

@@ -22,6 +22,7 @@ namespace {
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
+using rp::test::numbersAfter;
 using rp::test::runMerged;
 
 class TwoHosts : public ::testing::Test {
@@ -82,15 +83,6 @@ TEST_F(TwoHosts, AReaderOnTheOtherHostGetsTheArmOverTheLinkOnly) {
   while (std::fgets(line, sizeof line, arm)) rest += line;
   const int status = pclose(arm);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << rest;
-}
-
-std::vector<double> numbersAfter(const std::string& text, const std::string& word) {
-  std::vector<double> v;
-  const std::size_t at = text.find(word);
-  if (at == std::string::npos) return v;
-  std::istringstream in(text.substr(at + word.size()));
-  for (double x; in >> x;) v.push_back(x);
-  return v;
 }
 
 // The other host drives the arm: Figure 21's motions as a program whose [leader] is a

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace rp::test {
 
@@ -19,6 +20,17 @@ struct Outcome {
   int status = -1;
   std::string out, err;
 };
+
+// The numbers that follow the first `word` in `text` (a program's "final 0.1 0.2 ..." line), up
+// to the first thing that is not a number; empty if `word` does not occur.
+inline std::vector<double> numbersAfter(const std::string& text, const std::string& word) {
+  std::vector<double> v;
+  const std::size_t at = text.find(word);
+  if (at == std::string::npos) return v;
+  std::istringstream in(text.substr(at + word.size()));
+  for (double x; in >> x;) v.push_back(x);
+  return v;
+}
 
 // The whole file at `path` ("" if it cannot be read).
 inline std::string slurp(const std::string& path) {
