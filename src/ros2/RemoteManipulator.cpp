@@ -121,14 +121,13 @@ struct RemoteManipulator::Impl {
   }
 
   // Takes every joint_states sample received; true if one of the arm's came.
-  bool takeJointStates(RemoteManipulator& self);
+  bool takeJointStates();
   // Takes every `<object>/state` sample; returns a fault message ("" if none).
   std::string takeStates();
   void write(const Setpoint& s, const JointVector& qmin, const JointVector& qmax);
 };
 
-bool RemoteManipulator::Impl::takeJointStates(RemoteManipulator& self) {
-  (void)self;
+bool RemoteManipulator::Impl::takeJointStates() {
   bool got = false;
   for (;;) {
     void* loan[1] = {nullptr};
@@ -391,7 +390,7 @@ void RemoteManipulator::connect() {
   // The first joint state and state of the arm.
   bool joints = false;
   while (!joints || !d.haveBaseline) {
-    joints = d.takeJointStates(*this) || joints;
+    joints = d.takeJointStates() || joints;
     const std::string fault = d.takeStates();
     if (!fault.empty()) throw std::runtime_error(fault);
     if (joints && d.haveBaseline) break;
@@ -426,7 +425,7 @@ void RemoteManipulator::connect() {
 
 void RemoteManipulator::control() {
   Impl& d = *impl_;
-  d.takeJointStates(*this);
+  d.takeJointStates();
   std::string fault;
   try {
     fault = d.takeStates();

@@ -182,8 +182,7 @@ struct Ros2Bridge::Impl {
   void takeTrajectories(Manipulator& m, ArmEntry& e);
   std::string executeTrajectory(Manipulator& m, ArmEntry& e, const trajectory_msgs_msg_dds__JointTrajectory_& msg);
   void writeSample(const ManipulatorModel& model, ArmEntry& e, const JointVector& q, const JointVector& qd,
-                   const JointVector& tau, const builtin_interfaces_msg_dds__Time_& stamp,
-                   std::vector<geometry_msgs_msg_dds__TransformStamped_>& transforms);
+                   const JointVector& tau, const builtin_interfaces_msg_dds__Time_& stamp);
   void cycle();
   void publishCombinedDescription();
 };
@@ -452,8 +451,7 @@ void Ros2Bridge::Impl::publishCombinedDescription() {
 
 // One arm's sample: its joint_states message, and its frames added to this cycle's tf message.
 void Ros2Bridge::Impl::writeSample(const ManipulatorModel& model, ArmEntry& e, const JointVector& q, const JointVector& qd,
-                                   const JointVector& tau, const builtin_interfaces_msg_dds__Time_& stamp,
-                                   std::vector<geometry_msgs_msg_dds__TransformStamped_>& transforms) {
+                                   const JointVector& tau, const builtin_interfaces_msg_dds__Time_& stamp) {
   const int n = model.getNumberOfJoints();
   if (e.jointNamePointers.size() != e.jointNames.size()) {  // once, where the entry stays (arms' map)
     e.jointNamePointers.clear();
@@ -549,7 +547,7 @@ void Ros2Bridge::Impl::cycle() {
       tau = m->getControlOutput();
     }
     if (q.size() != n || qd.size() != n || tau.size() != n) continue;
-    if (fresh) writeSample(model, e, q, qd, tau, stamp, transforms);
+    if (fresh) writeSample(model, e, q, qd, tau, stamp);
     if (!full) continue;
     takeTrajectories(*m, e);
 

@@ -46,7 +46,9 @@ class Manipulator : public PhysicalObject {
   virtual JointVector getJointPosition() const = 0;
   /// Joint velocities (n x 1) [rad/s]. Real-time safe: yes.
   virtual JointVector getJointVelocity() const = 0;
-  /// The setpoint of the current cycle (n x 1 each). Real-time safe: yes.
+  /// The setpoint of the current cycle (n x 1 each): a reference to the servo thread's own, for
+  /// that thread (a ServoControl's calculate()); another thread that reads it races with the
+  /// cycle that writes it. Real-time safe: yes.
   virtual const Setpoint& getSetpoint() const = 0;
   /// The control output (joint torques) last written (n x 1) [N m]. Real-time safe: yes.
   virtual JointVector getControlOutput() const = 0;
