@@ -1062,6 +1062,7 @@ void DefaultManipulator::publish() {
   PublishedState s;
   s.time = getTime();
   s.readTime = readTime_;
+  s.cycle = getCycleCount();
   s.n = static_cast<int>(q_.size());
   s.power = power_;
   s.missed = missedCycles_;
@@ -1143,6 +1144,7 @@ bool DefaultManipulator::getStateSnapshot(StateSnapshot& snapshot) const {
   published_.read(s);
   snapshot.time = s.time;
   snapshot.readTime = s.readTime;
+  snapshot.cycle = s.cycle;
   snapshot.size = 3 * s.n + 3;
   for (int i = 0; i < s.n; ++i) {
     snapshot.values[i] = s.q[i];

@@ -46,32 +46,66 @@ using ros2detail::rosName;
 using ros2detail::validInterface;
 using ros2detail::validNamespace;
 
+std::int64_t wallNanoseconds() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
 builtin_interfaces_msg_dds__Time_ now() {
-  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                      std::chrono::system_clock::now().time_since_epoch())
-                      .count();
+  const std::int64_t ns = wallNanoseconds();
   builtin_interfaces_msg_dds__Time_ t{};
   t.sec = static_cast<int32_t>(ns / 1000000000);
   t.nanosec = static_cast<uint32_t>(ns % 1000000000);
   return t;
 }
 
+// The wall clock (ROS time) of a control program's real clock: one offset between the two,
+// measured with the program's clock read just before and just after the wall clock (the tightest
+// of three tries), and measured again each second, as NTP slews or steps the wall clock. Stamps
+// of successive cycles are then exactly as far apart as the cycles' read times, without the noise
+// of two clock reads per sample (a thread preempted between them would shift one stamp).
+struct WallClockMapping {
+  const Clock* clock = nullptr;
+  std::int64_t offsetNs = 0;          // wall clock - program clock [ns]
+  double measuredAt = -1;             // program clock time of the measurement [s]
+
+  // The wall-clock time of clock time `t`, or `publishedAt` where `t` is not of the last second.
+  builtin_interfaces_msg_dds__Time_ stamp(const Clock& c, double t, const builtin_interfaces_msg_dds__Time_& publishedAt) {
+    const double clockNow = c.getTime();
+    const double age = clockNow - t;
+    if (!(age >= 0 && age < 1)) return publishedAt;
+    if (&c != clock || !(clockNow - measuredAt < 1.0 && clockNow >= measuredAt)) measure(c);
+    const std::int64_t ns = std::llround(t * 1e9) + offsetNs;
+    builtin_interfaces_msg_dds__Time_ r{};
+    r.sec = static_cast<int32_t>(ns / 1000000000LL);
+    r.nanosec = static_cast<uint32_t>(ns % 1000000000LL);
+    return r;
+  }
+
+  void measure(const Clock& c) {
+    double bracket = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k) {
+      const double before = c.getTime();
+      const std::int64_t wall = wallNanoseconds();
+      const double after = c.getTime();
+      if (after - before < bracket) {
+        bracket = after - before;
+        offsetNs = wall - std::llround(0.5 * (before + after) * 1e9);
+        measuredAt = after;
+      }
+    }
+    clock = &c;
+  }
+};
+
 // The wall-clock time of the servo cycle that took a snapshot at clock time `cycleTime`: on the
-// real clock, the wall clock now minus the snapshot's age (both clocks read back to back); on a
-// simulated clock (whose time is not the wall's) the time of publication.
-builtin_interfaces_msg_dds__Time_ cycleStamp(Manipulator& m, double cycleTime, const builtin_interfaces_msg_dds__Time_& publishedAt) {
+// real clock, through the arm's WallClockMapping; on a simulated clock (whose time is not the
+// wall's) the time of publication.
+builtin_interfaces_msg_dds__Time_ cycleStamp(Manipulator& m, WallClockMapping& wall, double cycleTime,
+                                             const builtin_interfaces_msg_dds__Time_& publishedAt) {
   const ControlProgram* program = m.getControlProgram();
   if (program == nullptr || program->getClock().isSimulated()) return publishedAt;
-  const double clockNow = program->getClock().getTime();
-  const builtin_interfaces_msg_dds__Time_ wallNow = now();
-  const double age = clockNow - cycleTime;
-  if (!(age >= 0 && age < 1)) return publishedAt;
-  const std::int64_t ns = static_cast<std::int64_t>(wallNow.sec) * 1000000000LL + wallNow.nanosec -
-                          static_cast<std::int64_t>(age * 1e9);
-  builtin_interfaces_msg_dds__Time_ t{};
-  t.sec = static_cast<int32_t>(ns / 1000000000LL);
-  t.nanosec = static_cast<uint32_t>(ns % 1000000000LL);
-  return t;
+  return wall.stamp(program->getClock(), cycleTime, publishedAt);
 }
 
 // Quaternion (x, y, z, w) of a rotation matrix, w >= 0.
@@ -104,6 +138,7 @@ struct ArmEntry {
   std::chrono::steady_clock::time_point lastStateTime;
   bool seen = false;
   double lastTime = std::numeric_limits<double>::quiet_NaN();  // the servo cycle (its time) published last
+  WallClockMapping wall;  // the arm's clock to the stamps' wall clock
   dds_entity_t trajectoryReader = 0;
   std::unique_ptr<TimedTrajectoryGenerator> generator;  // connected to the arm on the first trajectory taken
   std::string lastCommand;  // the message about the last trajectory (accepted or refused)
@@ -540,7 +575,7 @@ void Ros2Bridge::Impl::cycle() {
       power = snap.values[3 * n] != 0;
       // Stamped with the time the cycle read the joints, as ros2_control's joint_state_broadcaster
       // stamps with the time of the controller manager's read.
-      stamp = cycleStamp(*m, snap.readTime > 0 ? snap.readTime : snap.time, publishedAt);
+      stamp = cycleStamp(*m, e.wall, snap.readTime > 0 ? snap.readTime : snap.time, publishedAt);
     } else {
       q = m->getJointPosition();
       qd = m->getJointVelocity();

@@ -930,7 +930,8 @@ class AllocationProbe : public ServoControl {
 
 // StateSnapshot::readTime, which the ROS 2 bridge stamps joint states with: on a simulated clock
 // the cycle's time; on a real clock later than the cycle's scheduled time (the loop wakes at or
-// after it, then reads) and never later than the moment the snapshot is taken.
+// after it, then reads) and never later than the moment the snapshot is taken. StateSnapshot::cycle
+// numbers the cycles: one more per period of the simulated clock, and rising on the real one.
 TEST_F(ManipulatorTest, TheStateSnapshotSaysWhenTheCycleReadTheJoints) {
   {
     Puma560 puma("puma");
@@ -939,6 +940,11 @@ TEST_F(ManipulatorTest, TheStateSnapshotSaysWhenTheCycleReadTheJoints) {
     ASSERT_TRUE(puma.getStateSnapshot(s));
     EXPECT_GT(s.time, 0);
     EXPECT_EQ(s.readTime, s.time);
+    ASSERT_TRUE(puma.waitForCycles(7));
+    StateSnapshot later;
+    ASSERT_TRUE(puma.getStateSnapshot(later));
+    EXPECT_GE(later.cycle, s.cycle + 7);
+    EXPECT_NEAR((later.time - s.time) * puma.getRate(), static_cast<double>(later.cycle - s.cycle), 1e-6);
   }
   RoboticPlatform::useRealClock();
   {
@@ -947,6 +953,7 @@ TEST_F(ManipulatorTest, TheStateSnapshotSaysWhenTheCycleReadTheJoints) {
     const Clock& clock = puma.getControlProgram()->getClock();
     ASSERT_FALSE(clock.isSimulated());
     double lastTime = -1;
+    std::uint64_t lastCycle = 0;
     int cycles = 0;
     for (int i = 0; i < 200 && cycles < 20; ++i) {
       StateSnapshot s;
@@ -957,6 +964,10 @@ TEST_F(ManipulatorTest, TheStateSnapshotSaysWhenTheCycleReadTheJoints) {
         continue;
       }
       lastTime = s.time;
+      if (cycles > 0) {
+        EXPECT_GT(s.cycle, lastCycle) << "a later cycle with no later number";
+      }
+      lastCycle = s.cycle;
       ++cycles;
       EXPECT_GT(s.readTime, s.time) << "read before the cycle's scheduled time";
       EXPECT_LE(s.readTime, now) << "read after the snapshot was taken";

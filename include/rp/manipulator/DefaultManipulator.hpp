@@ -268,6 +268,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   struct PublishedState {
     double time = 0;
     double readTime = 0;  // the clock when the cycle read the joints
+    std::uint64_t cycle = 0;  // the program's cycle count when the cycle published it
     int n = 0;
     bool power = false;
     double missed = 0, saturated = 0;  // servo cycles missed and saturated so far
