@@ -201,6 +201,8 @@ void bindPlatform(py::module_& m) {
           "a copy of the model (for its pose now)")
       .def("joint_position", [](const PyManipulator& p) { return fromVector(p.get().getJointPosition()); })
       .def("joint_velocity", [](const PyManipulator& p) { return fromVector(p.get().getJointVelocity()); })
+      .def("desired_joint_position", [](const PyManipulator& p) { return fromVector(p.get().getDesiredJointPosition()); },
+           "the setpoint's position the last servo cycle published [rad]")
       .def("control_output", [](const PyManipulator& p) { return fromVector(p.get().getControlOutput()); })
       .def("end_effector_transform", [](const PyManipulator& p) { return fromMatrix(p.get().getEndEffectorTransform()); })
       .def("enable_arm_power", [](const PyManipulator& p) { p.get().enableArmPower(); })

@@ -393,6 +393,15 @@ JointVector DefaultManipulator::getJointVelocity() const {
 
 const Setpoint& DefaultManipulator::getSetpoint() const { return setpoint_; }
 
+JointVector DefaultManipulator::getDesiredJointPosition() const {
+  if (inServoThread()) return setpoint_.position;
+  PublishedState s = initial_;
+  published_.read(s);
+  JointVector qdes(s.n);
+  for (int i = 0; i < s.n; ++i) qdes(i) = s.qdes[i];
+  return qdes;
+}
+
 JointVector DefaultManipulator::getControlOutput() const {
   if (inServoThread()) return tau_;
   PublishedState s = initial_;

@@ -74,6 +74,7 @@ struct RemoteManipulator::Impl {
   // The state received (other threads read it under the lock).
   mutable std::mutex stateMutex;
   JointVector q, qd, tau;
+  JointVector qdes;  // the loop's setpoint position, published at the end of each cycle
   bool remotePower = false;
   std::string remoteState;
   std::uint64_t refusedBaseline = 0;
@@ -384,7 +385,7 @@ void RemoteManipulator::connect() {
     const std::string j = d.model->getJointName(i);
     d.jointNames.push_back(j.rfind(prefix, 0) == 0 ? j : prefix + j);
   }
-  for (JointVector* v : {&d.q, &d.qd, &d.tau, &d.qLoop, &d.hold}) v->setZero(d.n);
+  for (JointVector* v : {&d.q, &d.qd, &d.tau, &d.qdes, &d.qLoop, &d.hold}) v->setZero(d.n);
   for (JointVector* v : {&d.setpoint.position, &d.setpoint.velocity, &d.setpoint.acceleration}) v->setZero(d.n);
 
   // The first joint state and state of the arm.
@@ -401,6 +402,7 @@ void RemoteManipulator::connect() {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   d.hold = d.qLoop;
+  d.setpoint.position = d.qdes = d.qLoop;
 
   // The message: names and the two points' buffers, made once.
   for (const std::string& name : d.jointNames) d.names.push_back(const_cast<char*>(name.c_str()));
@@ -451,6 +453,14 @@ void RemoteManipulator::control() {
   const bool on = d.streaming.load() && !d.faulted.load() && d.remotePowerFlag.load() && !ObjectManager::isShutdownRequested();
   if (!on || changes || holdRequested) d.hold = d.qLoop;
   d.setpoint.position = d.hold;
+  // The cycle's setpoint position for other threads (getDesiredJointPosition()), however the cycle ends.
+  struct PublishSetpoint {
+    Impl& d;
+    ~PublishSetpoint() {
+      std::lock_guard<std::mutex> lock(d.stateMutex);
+      d.qdes = d.setpoint.position;
+    }
+  } publishSetpoint{d};
   d.setpoint.velocity.setZero();
   d.setpoint.acceleration.setZero();
   if (g == nullptr || !on) return;
@@ -524,6 +534,11 @@ JointVector RemoteManipulator::getJointVelocity() const {
 }
 
 const Setpoint& RemoteManipulator::getSetpoint() const { return impl_->setpoint; }
+
+JointVector RemoteManipulator::getDesiredJointPosition() const {
+  std::lock_guard<std::mutex> lock(impl_->stateMutex);
+  return impl_->qdes;
+}
 
 JointVector RemoteManipulator::getControlOutput() const {
   std::lock_guard<std::mutex> lock(impl_->stateMutex);

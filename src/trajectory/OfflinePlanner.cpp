@@ -29,6 +29,7 @@ class OfflinePlanner::Arm : public Manipulator {
   JointVector getJointPosition() const override { return q_; }
   JointVector getJointVelocity() const override { return JointVector::Zero(q_.size()); }
   const Setpoint& getSetpoint() const override { return setpoint_; }
+  JointVector getDesiredJointPosition() const override { return setpoint_.position; }
   JointVector getControlOutput() const override { return JointVector::Zero(q_.size()); }
   void setControlOutput(const Eigen::Ref<const Eigen::VectorXd>&) override { refuse("setControlOutput"); }
   void enableArmPower() override { refuse("enableArmPower"); }

@@ -237,6 +237,48 @@ class CycleSpan : public ServoControl {
   ServoControl& inner_;
 };
 
+// Checks, in the servo thread, that getDesiredJointPosition() is the cycle's own setpoint there.
+class SetpointProbe : public ServoControl {
+ public:
+  explicit SetpointProbe(ServoControl& inner) : inner_(inner) {}
+  ~SetpointProbe() override { releaseFromManipulator(); }
+  void attach(Manipulator& m) override {
+    ServoControl::attach(m);
+    if (inner_.getManipulator() != &m) inner_.attach(m);
+  }
+  void activate() override { inner_.activate(); }
+  void calculate() override {
+    ++cycles;
+    if (d_manipulator->getDesiredJointPosition() != d_manipulator->getSetpoint().position) ++different;
+    inner_.calculate();
+  }
+  std::atomic<int> cycles{0}, different{0};
+
+ private:
+  ServoControl& inner_;
+};
+
+// getDesiredJointPosition(): the setpoint's position, for the servo thread this cycle's, for other
+// threads the last cycle's, as the trajectory generator gave it.
+TEST_F(ManipulatorTest, TheDesiredJointPositionIsTheSetpointInAnyThread) {
+  Puma560 puma;
+  ASSERT_TRUE(puma.waitForCycles(2));
+  const JointVector home = puma.getJointPosition();
+  EXPECT_EQ(puma.getDesiredJointPosition(), home) << "holding where the arm started";
+  JointVector target = home;
+  target(1) -= 0.05;
+  target(4) += 0.1;
+  StepGenerator gen(target, 0.0);
+  SetpointProbe probe(puma.getDefaultPositionControl());
+  puma.setServoControl(probe);
+  puma.setTrajectoryGenerator(gen);
+  ASSERT_TRUE(puma.waitForCycles(20));
+  EXPECT_EQ(puma.getDesiredJointPosition(), target) << "the step's target, not where the arm is";
+  EXPECT_GT((puma.getJointPosition() - target).norm(), 1e-3) << "the arm is still on its way";
+  EXPECT_GE(probe.cycles.load(), 20);
+  EXPECT_EQ(probe.different.load(), 0);
+}
+
 TEST_F(ManipulatorTest, ServoControlsSwitchMidMotion) {
   // A step on joint 1 under the default control; 30 cycles in, with the joint moving, a stiffer
   // PID takes over. The switch happens between two cycles: the new control's first cycle is the

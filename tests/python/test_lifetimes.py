@@ -40,6 +40,7 @@ tragen = rp.TrajectoryGenerator()
 calls = {
     "name": lambda a: a.name, "dof": lambda a: a.dof, "model": lambda a: a.model,
     "joint_position": lambda a: a.joint_position(), "joint_velocity": lambda a: a.joint_velocity(),
+    "desired_joint_position": lambda a: a.desired_joint_position(),
     "control_output": lambda a: a.control_output(), "end_effector_transform": lambda a: a.end_effector_transform(),
     "enable_arm_power": lambda a: a.enable_arm_power(), "disable_arm_power": lambda a: a.disable_arm_power(),
     "arm_power": lambda a: a.arm_power, "set_gravity_compensation": lambda a: a.set_gravity_compensation(True),

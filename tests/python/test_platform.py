@@ -89,6 +89,7 @@ def test_a_motion_from_python_reaches_its_target_and_the_generator_outlives_its_
             if np.abs(np.degrees(puma.joint_position()) - [0, 45, -90, 0, 0, 0]).max() < 0.01: break
         print(np.degrees(puma.joint_position()).round(2).tolist(), puma.error_code)
         puma.set_parameter("kp", puma.parameter("kp"))
+        print("desired", np.degrees(puma.desired_joint_position()).tolist())
         try:
             puma.set_parameter("kp", [1e9] * 6)
         except ValueError as e:
@@ -99,7 +100,10 @@ def test_a_motion_from_python_reaches_its_target_and_the_generator_outlives_its_
     lines = r.stdout.splitlines()
     np.testing.assert_allclose(numbers(lines[0])[:6], [0, 45, -90, 0, 0, 0], atol=0.01)
     assert lines[0].endswith(" 0")
-    assert "refused:" in lines[1] and "outside" in lines[1]
+    # The setpoint is the move's end exactly (the arm within the PID's dead band of it).
+    assert lines[1].startswith("desired")
+    np.testing.assert_allclose(numbers(lines[1]), [0, 45, -90, 0, 0, 0], atol=1e-9)
+    assert "refused:" in lines[2] and "outside" in lines[2]
 
 
 def test_bad_switches_and_configurations_are_python_exceptions(tmp_path):

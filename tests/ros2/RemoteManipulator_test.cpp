@@ -215,6 +215,9 @@ TEST_F(RemoteManipulatorTest, ReportsLatencyLossAndTheRemoteRefusal) {
   EXPECT_EQ(m.getNumberOfJoints(), 6);
   EXPECT_TRUE(m.isArmPowerOn());
   EXPECT_EQ(m.getModel().getJointName(0).rfind("puma_", 0), 0u) << m.getModel().getJointName(0);
+  // Holding where the remote arm was when it connected (its simulation settles by far less).
+  EXPECT_LT((m.getDesiredJointPosition() - m.getJointPosition()).norm(), 1e-3);
+  EXPECT_GT(m.getDesiredJointPosition().norm(), 0.1) << "the arm's position, not zeros";
   DefaultTrajectoryGenerator<6> tragen;
   m.setTrajectoryGenerator(tragen);
   JointVector target = m.getJointPosition();

@@ -126,6 +126,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   JointVector getJointPosition() const override;
   JointVector getJointVelocity() const override;
   const Setpoint& getSetpoint() const override;
+  JointVector getDesiredJointPosition() const override;
   JointVector getControlOutput() const override;
   void setControlOutput(const Eigen::Ref<const Eigen::VectorXd>& torque) override;
 

@@ -50,6 +50,9 @@ class Manipulator : public PhysicalObject {
   /// that thread (a ServoControl's calculate()); another thread that reads it races with the
   /// cycle that writes it. Real-time safe: yes.
   virtual const Setpoint& getSetpoint() const = 0;
+  /// The setpoint's position (n x 1) [rad] for any thread: in the servo thread this cycle's, in
+  /// another the one the last servo cycle published (a consistent copy). Real-time safe: yes.
+  virtual JointVector getDesiredJointPosition() const = 0;
   /// The control output (joint torques) last written (n x 1) [N m]. Real-time safe: yes.
   virtual JointVector getControlOutput() const = 0;
   /// Sets this cycle's control output: joint torques [N m] (servo thread).

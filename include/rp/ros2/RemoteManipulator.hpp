@@ -127,6 +127,7 @@ class RemoteManipulator : public Manipulator, public ControlProgram {
   /// The last setpoint streamed (the generator's, or the hold while none drives the arm); read it
   /// from the streaming thread only (e.g. from a generator).
   const Setpoint& getSetpoint() const override;
+  JointVector getDesiredJointPosition() const override;
   /// The last joint efforts received (the remote arm's commanded torques). Real-time safe: no.
   JointVector getControlOutput() const override;
   /// Not possible on a remote arm. @throws std::logic_error
