@@ -304,9 +304,9 @@ TEST(BusyMachine, OnTheRealClockTheSimulatedArmMovesOnThroughAStall) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     ASSERT_EQ(push.count.load(), StallingPush::kCycles);
     puma.disableArmPower();
-    // The stall: the largest gap between two cycles' times.
-    int k = 1;
-    for (int i = 1; i < StallingPush::kCycles; ++i)
+    // The stall: the largest gap between two cycles' times (with 20 cycles before it to compare).
+    int k = 21;
+    for (int i = 21; i < StallingPush::kCycles; ++i)
       if (push.time[i] - push.time[i - 1] > push.time[k] - push.time[k - 1]) k = i;
     const double gap = push.time[k] - push.time[k - 1];
     ASSERT_GT(gap, 0.05);

@@ -148,7 +148,7 @@ TEST(ClientServerThreads, TimeoutsFullQueueHandlerErrorsAndCleanStop) {
   }
   PendingReply<int> dropped = client.send(6);
   std::thread stopper([&] { server.stop(); });
-  std::this_thread::sleep_for(10ms);
+  while (server.isRunning()) std::this_thread::sleep_for(1ms);  // stop() has taken the queue
   gate.unlock();  // let the request being served finish; the queued one is failed
   stopper.join();
   try {
