@@ -10,12 +10,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
+#include "../rt/CycleSignal.hpp"
 #include "Ros2Common.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/TypeDatabase.hpp"
@@ -23,6 +25,7 @@
 #include "rp/model/ManipulatorData.hpp"
 #include "rp/model/UrdfModel.hpp"
 #include "rp/ros2/Ros2Bridge.hpp"
+#include "rp/rt/TripleBuffer.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
 #include "sensor_msgs.h"
 #include "std_msgs.h"
@@ -43,6 +46,8 @@ constexpr double kStopTime = 0.2;   // the stop after it [s]
 // horizon, a setpoint up to 12 ms late is still reachable.
 constexpr double kVelocityReserve = 0.8;
 constexpr std::size_t kLatencies = 4096;
+
+constexpr double kIoWakeup = 0.01;   // the longest sleep of the I/O threads [s]
 
 double wallSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -71,22 +76,39 @@ struct RemoteManipulator::Impl {
   int n = 0;
   std::vector<std::string> jointNames;  // `<object>_<joint>`, as in joint_states
 
-  // The state received (other threads read it under the lock).
+  // The state received by the reader thread (other threads read it under the lock).
   mutable std::mutex stateMutex;
   JointVector q, qd, tau;
-  JointVector qdes;  // the loop's setpoint position, published at the end of each cycle
   bool remotePower = false;
   std::string remoteState;
   std::uint64_t refusedBaseline = 0;
   bool haveBaseline = false;
+  // The reader thread's own.
+  std::chrono::steady_clock::time_point lastReceipt;
+  double lastStamp = -1;
+  std::array<int, kMaxJoints> column{};  // model joint -> joint_states column
+
+  // Between the loop and the I/O threads, without a lock or a wait on the loop's side.
+  struct Joints {
+    double q[kMaxJoints];
+  };
+  struct Stream {  // the next trajectory to write: its two points
+    std::uint64_t sequence;
+    double positions[2][kMaxJoints], velocities[2][kMaxJoints];
+  };
+  TripleBuffer<Joints> received;  // reader thread -> loop (its only reader)
+  TripleBuffer<Stream> stream;    // loop -> writer thread (its only reader)
+  TripleBuffer<Joints> desired;   // loop -> any thread: the cycle's setpoint position
+  std::thread reader, writer;
+  std::atomic<bool> stopIo{false};
+  dds_entity_t waitset = 0, wake = 0;  // the reader's waitset and the guard condition that ends its wait
 
   // The loop's own.
   JointVector qLoop, hold;
   Setpoint setpoint;
   TrajectoryGenerator* activeGenerator = nullptr;
-  std::chrono::steady_clock::time_point lastReceipt;
-  double lastStamp = -1;
-  std::array<int, kMaxJoints> column{};  // model joint -> joint_states column
+  std::uint64_t sequence = 0;
+  Stream next{};  // the trajectory this cycle hands to the writer
 
   std::atomic<TrajectoryGenerator*> generator{nullptr};
   std::atomic<const void*> executing{nullptr};
@@ -106,8 +128,16 @@ struct RemoteManipulator::Impl {
   trajectory_msgs_msg_dds__JointTrajectory_ message{};
 
   ~Impl() {
+    stopThreads();
     if (participant > 0) dds_delete(participant);
     if (domain > 0) dds_delete(domain);
+  }
+
+  void stopThreads() {
+    stopIo = true;
+    if (wake > 0) dds_set_guardcondition(wake, true);
+    if (reader.joinable()) reader.join();
+    if (writer.joinable()) writer.join();
   }
 
   dds_entity_t endpoint(const dds_topic_descriptor_t& desc, const std::string& topic, bool transientLocal, bool isReader) {
@@ -125,7 +155,11 @@ struct RemoteManipulator::Impl {
   bool takeJointStates();
   // Takes every `<object>/state` sample; returns a fault message ("" if none).
   std::string takeStates();
-  void write(const Setpoint& s, const JointVector& qmin, const JointVector& qmax);
+  // The reader thread: waits for samples, takes them, hands the joints to the loop and raises
+  // the faults it finds (through `fault`, once).
+  void read(const std::function<void(const std::string&)>& fault);
+  // The writer thread: after each cycle of a loop, writes the loop's new trajectory, if any.
+  void write();
 };
 
 bool RemoteManipulator::Impl::takeJointStates() {
@@ -157,8 +191,10 @@ bool RemoteManipulator::Impl::takeJointStates() {
           qd(i) = js.velocity._length == js.name._length ? js.velocity._buffer[c] : 0.0;
           tau(i) = js.effort._length == js.name._length ? js.effort._buffer[c] : 0.0;
         }
-        qLoop = q;
       }
+      Joints j{};
+      for (int i = 0; i < n; ++i) j.q[i] = js.position._buffer[static_cast<uint32_t>(column[static_cast<std::size_t>(i)])];
+      received.write(j);
       std::lock_guard<std::mutex> lock(statsMutex);
       ++samples;
       latencies[latencyCount++ % kLatencies] = receipt - stamp;
@@ -221,22 +257,43 @@ std::string RemoteManipulator::Impl::takeStates() {
   return fault;
 }
 
-void RemoteManipulator::Impl::write(const Setpoint& s, const JointVector& qmin, const JointVector& qmax) {
-  for (int i = 0; i < n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    const double p = s.position(i), v = s.velocity.size() == n ? s.velocity(i) : 0.0;
-    positions[0][k] = p;
-    velocities[0][k] = v;
-    // The stop from there at constant deceleration (a cubic with these ends is exactly that).
-    positions[1][k] = std::clamp(p + v * kStopTime / 2, qmin(i), qmax(i));
-    velocities[1][k] = 0;
+void RemoteManipulator::Impl::read(const std::function<void(const std::string&)>& fault) {
+  const auto timeout = std::chrono::duration<double>(options.timeout);
+  while (!stopIo.load()) {
+    dds_waitset_wait(waitset, nullptr, 0, DDS_SECS(kIoWakeup));
+    if (stopIo.load()) break;
+    takeJointStates();
+    std::string message;
+    try {
+      message = takeStates();
+    } catch (const std::exception& e) {
+      message = std::string("the remote arm's state: ") + e.what();
+    }
+    if (message.empty() && std::chrono::steady_clock::now() - lastReceipt > timeout) {
+      char text[160];
+      std::snprintf(text, sizeof text, "no joint_states from %.60s for %.2f s: the remote arm or its process is gone",
+                    label.c_str(), options.timeout);
+      message = text;
+    }
+    if (!message.empty()) fault(message);
   }
-  if (dds_write(trajectory, &message) < 0) {
+}
+
+void RemoteManipulator::Impl::write() {
+  std::uint64_t seen = internal::cyclesEnded(), written = 0;
+  Stream s{};
+  while (!stopIo.load()) {
+    seen = internal::waitForCycleEnd(seen, kIoWakeup);
+    if (!stream.readAsOnlyReader(s) || s.sequence == written) continue;
+    written = s.sequence;
+    for (std::size_t k = 0; k < 2; ++k)
+      for (int i = 0; i < n; ++i) {
+        positions[k][static_cast<std::size_t>(i)] = s.positions[k][i];
+        velocities[k][static_cast<std::size_t>(i)] = s.velocities[k][i];
+      }
+    const bool ok = dds_write(trajectory, &message) >= 0;
     std::lock_guard<std::mutex> lock(statsMutex);
-    ++failures;
-  } else {
-    std::lock_guard<std::mutex> lock(statsMutex);
-    ++sent;
+    ++(ok ? sent : failures);
   }
 }
 
@@ -292,6 +349,7 @@ RemoteManipulator::RemoteManipulator(const std::string& name, const RemoteManipu
 
 RemoteManipulator::~RemoteManipulator() {
   stopControlLoop();
+  impl_->stopThreads();
   const RemoteManipulatorStatistics s = getStatistics();
   if (s.gaps > 0 || s.writeFailures > 0)
     std::fprintf(stderr,
@@ -385,7 +443,7 @@ void RemoteManipulator::connect() {
     const std::string j = d.model->getJointName(i);
     d.jointNames.push_back(j.rfind(prefix, 0) == 0 ? j : prefix + j);
   }
-  for (JointVector* v : {&d.q, &d.qd, &d.tau, &d.qdes, &d.qLoop, &d.hold}) v->setZero(d.n);
+  for (JointVector* v : {&d.q, &d.qd, &d.tau, &d.qLoop, &d.hold}) v->setZero(d.n);
   for (JointVector* v : {&d.setpoint.position, &d.setpoint.velocity, &d.setpoint.acceleration}) v->setZero(d.n);
 
   // The first joint state and state of the arm.
@@ -401,8 +459,10 @@ void RemoteManipulator::connect() {
                                " within " + std::to_string(o.connectTimeout) + " s (its description came)");
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  d.hold = d.qLoop;
-  d.setpoint.position = d.qdes = d.qLoop;
+  d.qLoop = d.hold = d.setpoint.position = d.q;
+  Impl::Joints desired{};
+  for (int i = 0; i < d.n; ++i) desired.q[i] = d.q(i);
+  d.desired.write(desired);
 
   // The message: names and the two points' buffers, made once.
   for (const std::string& name : d.jointNames) d.names.push_back(const_cast<char*>(name.c_str()));
@@ -423,28 +483,34 @@ void RemoteManipulator::connect() {
 
   setRate(o.rate);
   setThreadMode(ThreadMode::Own);
+
+  // The I/O threads: DDS is theirs from here on, the loop never waits for it.
+  d.waitset = dds_create_waitset(d.participant);
+  d.wake = dds_create_guardcondition(d.participant);
+  if (d.waitset < 0 || d.wake < 0) throw std::runtime_error("RemoteManipulator: cannot create a DDS waitset");
+  for (const dds_entity_t r : {d.jointStates, d.state}) {
+    const dds_entity_t c = dds_create_readcondition(r, DDS_ANY_STATE);
+    if (c < 0 || dds_waitset_attach(d.waitset, c, 0) < 0)
+      throw std::runtime_error("RemoteManipulator: cannot wait for samples: " + ddsError(c));
+  }
+  if (dds_waitset_attach(d.waitset, d.wake, 0) < 0) throw std::runtime_error("RemoteManipulator: cannot wait for samples");
+  d.reader = std::thread([this] { impl_->read([this](const std::string& fault) { raiseFault(fault); }); });
+  d.writer = std::thread([this] { impl_->write(); });
+}
+
+void RemoteManipulator::raiseFault(const std::string& fault) {
+  if (impl_->faulted.exchange(true)) return;
+  const std::string message = "RemoteManipulator '" + getName() + "': " + fault;
+  setError(1, message.c_str());
+  ObjectManager::requestSystemShutdown(message.c_str());
 }
 
 void RemoteManipulator::control() {
   Impl& d = *impl_;
-  d.takeJointStates();
-  std::string fault;
-  try {
-    fault = d.takeStates();
-  } catch (const std::exception& e) {
-    fault = std::string("the remote arm's state: ") + e.what();
-  }
-  if (fault.empty() && std::chrono::steady_clock::now() - d.lastReceipt > std::chrono::duration<double>(d.options.timeout)) {
-    char text[160];
-    std::snprintf(text, sizeof text, "no joint_states from %.60s for %.2f s: the remote arm or its process is gone", d.label.c_str(),
-                  d.options.timeout);
-    fault = text;
-  }
-  if (!fault.empty() && !d.faulted.exchange(true)) {
-    const std::string message = "RemoteManipulator '" + getName() + "': " + fault;
-    setError(1, message.c_str());
-    ObjectManager::requestSystemShutdown(message.c_str());
-  }
+  // The joints the reader thread took last (no DDS call, lock or allocation in the cycle).
+  Impl::Joints received;
+  if (d.received.readAsOnlyReader(received))
+    for (int i = 0; i < d.n; ++i) d.qLoop(i) = received.q[i];
 
   TrajectoryGenerator* g = d.generator.load(std::memory_order_acquire);
   const bool changes = g != d.activeGenerator;
@@ -457,15 +523,17 @@ void RemoteManipulator::control() {
   struct PublishSetpoint {
     Impl& d;
     ~PublishSetpoint() {
-      std::lock_guard<std::mutex> lock(d.stateMutex);
-      d.qdes = d.setpoint.position;
+      Impl::Joints desired;
+      for (int i = 0; i < d.n; ++i) desired.q[i] = d.setpoint.position(i);
+      d.desired.write(desired);
     }
   } publishSetpoint{d};
   d.setpoint.velocity.setZero();
   d.setpoint.acceleration.setZero();
   if (g == nullptr || !on) return;
   d.executing.store(g, std::memory_order_seq_cst);
-  std::string bad;
+  const char* bad = nullptr;
+  std::string thrown;
   try {
     if (d.generator.load(std::memory_order_seq_cst) == g && g->getCurrentSetpoint(getTime(), d.setpoint)) {
       if (!(d.setpoint.position.allFinite() && d.setpoint.velocity.allFinite()))
@@ -474,18 +542,28 @@ void RemoteManipulator::control() {
         d.hold = d.setpoint.position;
     }
   } catch (const std::exception& e) {
-    bad = std::string("the trajectory generator threw: ") + e.what();
+    thrown = std::string("the trajectory generator threw: ") + e.what();
+    bad = thrown.c_str();
   }
   d.executing.store(nullptr, std::memory_order_release);
-  if (!bad.empty()) {
-    if (!d.faulted.exchange(true)) {
-      const std::string message = "RemoteManipulator '" + getName() + "': " + bad;
-      setError(1, message.c_str());
-      ObjectManager::requestSystemShutdown(message.c_str());
-    }
+  if (bad != nullptr) {
+    raiseFault(bad);
     return;
   }
-  d.write(d.setpoint, d.model->getPositionMin(), d.model->getPositionMax());
+  // The trajectory for the writer thread: the setpoint at kHorizon, then the stop from there at
+  // constant deceleration (a cubic with these ends is exactly that) kStopTime later.
+  Impl::Stream& out = d.next;
+  out.sequence = ++d.sequence;
+  const JointVector& qmin = d.model->getPositionMin();
+  const JointVector& qmax = d.model->getPositionMax();
+  for (int i = 0; i < d.n; ++i) {
+    const double p = d.setpoint.position(i), v = d.setpoint.velocity.size() == d.n ? d.setpoint.velocity(i) : 0.0;
+    out.positions[0][i] = p;
+    out.velocities[0][i] = v;
+    out.positions[1][i] = std::clamp(p + v * kStopTime / 2, qmin(i), qmax(i));
+    out.velocities[1][i] = 0;
+  }
+  d.stream.write(out);
 }
 
 const RemoteManipulatorOptions& RemoteManipulator::getOptions() const noexcept { return impl_->options; }
@@ -536,8 +614,11 @@ JointVector RemoteManipulator::getJointVelocity() const {
 const Setpoint& RemoteManipulator::getSetpoint() const { return impl_->setpoint; }
 
 JointVector RemoteManipulator::getDesiredJointPosition() const {
-  std::lock_guard<std::mutex> lock(impl_->stateMutex);
-  return impl_->qdes;
+  Impl::Joints desired{};
+  impl_->desired.read(desired);
+  JointVector q(impl_->n);
+  for (int i = 0; i < impl_->n; ++i) q(i) = desired.q[i];
+  return q;
 }
 
 JointVector RemoteManipulator::getControlOutput() const {

@@ -35,6 +35,8 @@ class Counted : public ControlProgram {
     q_ = kp_ * x_;
     StateSnapshot s{getTime(), getCycleCount(), 1, {x_}};
     snapshots.write(s);
+    inputs.write(s);
+    inputs.readAsOnlyReader(s);
   }
   void exitControl() override { allocations = static_cast<long>(test::allocationCount() - start_); }
 
@@ -46,6 +48,7 @@ class Counted : public ControlProgram {
     double values[8];
   };
   TripleBuffer<StateSnapshot> snapshots;
+  TripleBuffer<StateSnapshot> inputs;  // read by this thread only (readAsOnlyReader())
   std::size_t start_ = 0;
   double x_ = 0, gain_ = 1;
   Vector<6> q_, kp_ = Vector<6>::Constant(1);

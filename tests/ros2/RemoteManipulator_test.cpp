@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "../support/RunProgram.hpp"
+#include "AllocationCounter.hpp"
 #include "../support/ScratchDirectory.hpp"
 #include "Ros2Fixture.hpp"
 #include "rp/model/Kinematics.hpp"
@@ -201,6 +202,60 @@ TEST_F(RemoteManipulatorTest, AVanishedRemoteArmEndsTheProgramWithAnError) {
   EXPECT_TRUE(contains(remote.err, "no joint_states from " + ns_ + "/puma")) << remote.err;
   EXPECT_TRUE(contains(remote.out, "moving")) << remote.out;
   EXPECT_FALSE(contains(remote.out, "final")) << remote.out;
+}
+
+// A generator that holds `q` and counts, in the loop's thread, the allocations between two of its
+// calls: everything else the loop does in a cycle.
+class CountingHold : public TrajectoryGenerator {
+ public:
+  explicit CountingHold(const JointVector& q) : q_(q) {}
+  bool getCurrentSetpoint(double time, Setpoint& setpoint) override {
+    (void)time;
+    const std::size_t now = test::allocationCount();
+    if (calls_ > 2) allocations_ += now - last_;
+    ++calls_;
+    setpoint.position = q_;
+    last_ = test::allocationCount();
+    allocations.store(allocations_);
+    calls.store(calls_);
+    return true;
+  }
+  std::atomic<std::size_t> allocations{0};
+  std::atomic<long> calls{0};
+
+ private:
+  const JointVector q_;
+  std::size_t allocations_ = 0, last_ = 0;
+  long calls_ = 0;
+};
+
+// The loop makes no DDS call and does not allocate (the reader and writer threads do the DDS
+// work), while joint states keep coming in and a trajectory goes out each cycle.
+TEST_F(RemoteManipulatorTest, TheStreamingCycleDoesNotAllocate) {
+  auto arm = startArm();
+  RemoteManipulatorOptions o;
+  o.remote = ns_ + "/puma";
+  o.domain = options_.domain;
+  o.connectTimeout = 30;
+  RemoteManipulator m("leader", o);
+  ASSERT_TRUE(m.isArmPowerOn());
+  JointVector q = m.getJointPosition();
+  q(1) += 0.01;  // a small step, held
+  CountingHold hold(q);
+  m.setTrajectoryGenerator(hold);
+  const RemoteManipulatorStatistics before = m.getStatistics();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (hold.calls.load() < 200 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_GE(hold.calls.load(), 200);
+  EXPECT_EQ(hold.allocations.load(), 0u) << "over " << hold.calls.load() << " cycles";
+  const RemoteManipulatorStatistics after = m.getStatistics();
+  EXPECT_GT(after.samples, before.samples + 50) << "joint states came in meanwhile";
+  EXPECT_GT(after.trajectoriesSent, before.trajectoriesSent + 150) << "a trajectory went out each cycle";
+  EXPECT_EQ(m.getDesiredJointPosition(), q);
+  EXPECT_EQ(m.getErrorCode(), 0) << m.getErrorStatus().message;
+  m.clearTrajectoryGenerator();
+  stopArm(*arm);
 }
 
 // In this process, from code: the figures of the link, and the remote bridge's refusal (commands

@@ -193,5 +193,37 @@ TEST(TripleBufferThreads, ReadersSeeWholeValuesInOrder) {
   EXPECT_EQ(p.a, 50000);
 }
 
+// The one reader of readAsOnlyReader() (no lock): whole values, in order, and the last one.
+TEST(TripleBufferThreads, TheOnlyReaderSeesWholeValuesInOrderWithoutALock) {
+  TripleBuffer<Pair> buffer;
+  Pair p;
+  EXPECT_FALSE(buffer.readAsOnlyReader(p));
+  std::atomic<bool> reading{false};
+  bool torn = false, backwards = false;
+  long seen = 0;
+  long last = 0;
+  std::thread reader([&] {  // until it has the last value (or 20 s have passed)
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    Pair v;
+    reading = true;
+    while (last != 50000 && std::chrono::steady_clock::now() < deadline) {
+      if (!buffer.readAsOnlyReader(v)) continue;
+      if (v.b != 2 * v.a) torn = true;
+      if (v.a < last) backwards = true;
+      if (v.a != last) ++seen;
+      last = v.a;
+    }
+  });
+  while (!reading) std::this_thread::yield();
+  for (long i = 1; i <= 50000; ++i) buffer.write(Pair{i, 2 * i});
+  reader.join();
+  EXPECT_EQ(last, 50000) << "the reader never had the last value";
+  EXPECT_FALSE(torn);
+  EXPECT_FALSE(backwards);
+  EXPECT_GT(seen, 0);
+  ASSERT_TRUE(buffer.readAsOnlyReader(p));
+  EXPECT_EQ(p.a, 50000);
+}
+
 }  // namespace
 }  // namespace rp

@@ -61,9 +61,10 @@ struct RemoteManipulatorStatistics {
 ///   ends or dies), the arm stops within 250 ms of the last sample. The remote arm follows the
 ///   generator about 50 ms plus the network latency behind. Nothing is written while no
 ///   generator is set or the power is off here: the remote arm holds where it is.
-/// - Not a hard real-time servo loop: its thread takes DDS samples and writes over the network;
-///   the remote arm's servo loop runs in the remote process. It does not allocate in the cycle
-///   except when a `<object>/state` sample arrives (parsed as JSON, at most a few a second).
+/// - Its loop makes no DDS call and takes no lock: a reader thread waits for the arm's samples
+///   (joint_states, `<object>/state`, parsed as JSON) and hands the joints over through a
+///   TripleBuffer; a writer thread writes each cycle's trajectory after the cycle ends. The cycle
+///   does not allocate. The remote arm's servo loop runs in the remote process.
 /// - Faults: no joint_states from the arm for `timeout` seconds (default 0.5), a remote error or
 ///   shutdown, or a trajectory refused by the remote bridge sets this object's error status
 ///   (naming the remote arm) and requests a system shutdown, so every wait of a generator
@@ -195,6 +196,8 @@ class RemoteManipulator : public Manipulator, public ControlProgram {
 
  private:
   void connect();
+  // A fault (the link, the remote arm, the generator): the error status and a system shutdown, once.
+  void raiseFault(const std::string& fault);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -12,7 +12,7 @@ namespace rp {
 
 /// Latest-value channel from one writer thread to any number of readers (state snapshots of a
 /// servo thread read by the GUI). The writer never waits or allocates; readers take a mutex
-/// only among themselves.
+/// only among themselves, except the one reader of readAsOnlyReader(), which takes none.
 /// @tparam T  trivially copyable value type (e.g. StateSnapshot)
 template <typename T>
 class TripleBuffer {
@@ -39,6 +39,20 @@ class TripleBuffer {
   bool read(T& out) const {
     if (!written_.load(std::memory_order_acquire)) return false;
     std::lock_guard<std::mutex> lock(readMutex_);
+    if (middle_.load(std::memory_order_acquire) & kFresh) {
+      unsigned old = middle_.exchange(front_, std::memory_order_acq_rel);
+      front_ = old & kIndex;
+    }
+    out = buffers_[front_];
+    return true;
+  }
+  /// read() for a buffer that only one thread ever reads, and only with this function (a servo
+  /// thread taking the latest input an I/O thread wrote): no lock.
+  /// @param[out] out  receives the value
+  /// @return false if nothing has been written yet (out unchanged)
+  /// Real-time safe: yes.
+  bool readAsOnlyReader(T& out) const noexcept {
+    if (!written_.load(std::memory_order_acquire)) return false;
     if (middle_.load(std::memory_order_acquire) & kFresh) {
       unsigned old = middle_.exchange(front_, std::memory_order_acq_rel);
       front_ = old & kIndex;
