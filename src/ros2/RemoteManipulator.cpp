@@ -523,7 +523,7 @@ void RemoteManipulator::control() {
   struct PublishSetpoint {
     Impl& d;
     ~PublishSetpoint() {
-      Impl::Joints desired;
+      Impl::Joints desired{};
       for (int i = 0; i < d.n; ++i) desired.q[i] = d.setpoint.position(i);
       d.desired.write(desired);
     }
