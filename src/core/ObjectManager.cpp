@@ -235,6 +235,9 @@ bool ObjectManager::waitForShutdown(double timeoutSeconds) {
 
 std::string ObjectManager::getShutdownReason() {
   auto& reg = internal::registry();
+  // Under the lock of resetShutdown(): a reason is copied whole, never while a reset begins a new
+  // generation (the one request of a generation writes the reason before it is ready).
+  std::lock_guard<std::mutex> lock(reg.doneMutex);
   return reg.reasonReady.load(std::memory_order_acquire) ? std::string(reg.reason) : std::string();
 }
 
@@ -280,8 +283,7 @@ void ObjectManager::resetShutdown() {
   auto& reg = internal::registry();
   std::lock_guard<std::mutex> lock(reg.doneMutex);
   reg.done = false;
-  reg.reasonReady = false;
-  reg.reason[0] = '\0';
+  reg.reasonReady = false;  // the reason's text stays until the next request writes it
   reg.requested = 0;
 }
 

@@ -209,6 +209,7 @@ TEST_F(RemoteManipulatorTest, AVanishedRemoteArmEndsTheProgramWithAnError) {
 class CountingHold : public TrajectoryGenerator {
  public:
   explicit CountingHold(const JointVector& q) : q_(q) {}
+  ~CountingHold() override { withdrawObject(); }  // first: other threads (a shutdown) keep off from here on
   bool getCurrentSetpoint(double time, Setpoint& setpoint) override {
     (void)time;
     const std::size_t now = test::allocationCount();
