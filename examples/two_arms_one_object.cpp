@@ -32,7 +32,10 @@ class RigidGrasp : public TrajectoryGenerator {
         follower_(follower),
         grasp_(grasp),
         model_(dynamic_cast<const Puma560Model&>(follower.getModel())) {}
-  ~RigidGrasp() override { releaseFromManipulators(); }
+  ~RigidGrasp() override {
+    withdrawObject();  // first: a system shutdown's thread keeps off from here on
+    releaseFromManipulators();
+  }
 
   // Called in the follower's servo cycle (its control phase): the leader's joints were read in
   // this cycle's read phase.

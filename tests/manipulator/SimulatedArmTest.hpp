@@ -34,7 +34,10 @@ class SimulatedArmTest : public ::testing::Test {
 class ConstantTorque : public ServoControl {
  public:
   ConstantTorque(int joint, double torque, int cycles = -1) : joint_(joint), torque_(torque), cycles_(cycles) {}
-  ~ConstantTorque() override { releaseFromManipulator(); }
+  ~ConstantTorque() override {
+    withdrawObject();  // first: a system shutdown's thread keeps off from here on (RoboticObject's rule)
+    releaseFromManipulator();
+  }
   void calculate() override {
     ++calls;
     auto& m = dynamic_cast<DefaultManipulator&>(*d_manipulator);
@@ -57,7 +60,10 @@ class JointRamp : public TrajectoryGenerator {
  public:
   JointRamp(int joint, double speed, double duration = std::numeric_limits<double>::infinity())
       : joint_(joint), speed_(speed), duration_(duration) {}
-  ~JointRamp() override { releaseFromManipulators(); }
+  ~JointRamp() override {
+    withdrawObject();  // first: a system shutdown's thread keeps off from here on (RoboticObject's rule)
+    releaseFromManipulators();
+  }
   bool getCurrentSetpoint(double time, Setpoint& sp) override {
     if (t0_ < 0) {
       t0_ = time;

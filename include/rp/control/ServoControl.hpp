@@ -26,6 +26,10 @@ class Manipulator;
 ///
 /// Example (paper Figure 22): a class with `void calculate() override` that computes a
 /// virtual-wall force and calls `d_manipulator->setControlOutput(torque)`.
+///
+/// A subclass whose objects may be destroyed while a system shutdown runs (a fault, Ctrl-C: the
+/// shutdown's thread calls startShutdown() and isShutdownComplete() on every object) calls
+/// withdrawObject() first in its destructor, as RoboticObject says; the shutdown then keeps off it.
 class ServoControl : public FunctionalObject {
  public:
   /// Creates a servo control not yet attached to a manipulator.

@@ -20,6 +20,10 @@ class Manipulator;
 /// manipulators (paper Figure 23): each calls it with its own clock time, and on a shared clock
 /// they all see the same setpoints. getCurrentSetpoint() must be real-time safe and may be called
 /// from several servo threads at once.
+///
+/// A subclass whose objects may be destroyed while a system shutdown runs (a fault, Ctrl-C: the
+/// shutdown's thread calls startShutdown() and isShutdownComplete() on every object) calls
+/// withdrawObject() first in its destructor, as RoboticObject says; the shutdown then keeps off it.
 class TrajectoryGenerator : public FunctionalObject {
  public:
   /// Creates a generator.
