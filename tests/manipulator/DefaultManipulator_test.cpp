@@ -47,20 +47,14 @@ class StepGenerator : public TrajectoryGenerator {
 
 // Records the joint positions the servo thread sees at a given cycle, and the largest excursion
 // of one joint past a value, by wrapping another servo control.
-class Probe : public ServoControl {
+class Probe : public test::WrappedControl {
  public:
-  explicit Probe(ServoControl& inner, std::uint64_t recordAt = 0) : inner_(inner), recordAt_(recordAt) {}
-  ~Probe() override { releaseFromManipulator(); }
+  explicit Probe(ServoControl& inner, std::uint64_t recordAt = 0) : WrappedControl(inner), recordAt_(recordAt) {}
   // Track how far each joint goes past `target` (for steps in the positive direction).
   void trackOvershoot(const JointVector& target) {
     target_ = target;
     overshoot_.setZero(target.size());
   }
-  void attach(Manipulator& m) override {
-    ServoControl::attach(m);
-    if (inner_.getManipulator() != &m) inner_.attach(m);
-  }
-  void activate() override { inner_.activate(); }
   void calculate() override {
     ++cycles_;
     const JointVector q = d_manipulator->getJointPosition();
@@ -70,13 +64,12 @@ class Probe : public ServoControl {
       recorded_ = q;
       recordedFlag_.store(true);
     }
-    inner_.calculate();
+    inner().calculate();
   }
   bool recorded() const { return recordedFlag_.load(); }
   JointVector recorded_, overshoot_;
 
  private:
-  ServoControl& inner_;
   JointVector target_;
   std::uint64_t recordAt_;
   std::uint64_t cycles_ = 0;
@@ -150,14 +143,9 @@ class RampGenerator : public TrajectoryGenerator {
 // Wraps a servo control and counts its cycles; records the first cycle in which the state it is
 // given (the state the limit check of the same cycle sees) has joint `joint` past its velocity
 // limit (kind 'v') or its upper position limit (kind 'p').
-class FirstExcess : public ServoControl {
+class FirstExcess : public test::WrappedControl {
  public:
-  FirstExcess(ServoControl& inner, char kind, int joint) : inner_(inner), kind_(kind), joint_(joint) {}
-  ~FirstExcess() override { releaseFromManipulator(); }
-  void attach(Manipulator& m) override {
-    ServoControl::attach(m);
-    if (inner_.getManipulator() != &m) inner_.attach(m);
-  }
+  FirstExcess(ServoControl& inner, char kind, int joint) : WrappedControl(inner), kind_(kind), joint_(joint) {}
   void calculate() override {
     const int call = calls.load() + 1;
     const ManipulatorModel& model = d_manipulator->getModel();
@@ -165,12 +153,11 @@ class FirstExcess : public ServoControl {
                                    : d_manipulator->getJointPosition()(joint_) > model.getPositionMax()(joint_);
     if (past && first.load() == 0) first.store(call);
     calls.store(call);
-    inner_.calculate();
+    inner().calculate();
   }
   std::atomic<int> calls{0}, first{0};
 
  private:
-  ServoControl& inner_;
   char kind_;
   int joint_;
 };
@@ -212,15 +199,9 @@ TEST_F(ManipulatorTest, PositionViolationIsDetectedInTheCycleItHappens) {
 
 // Wraps a servo control and records the first and last servo cycles it ran in, and the speed of
 // joint 1 in its first cycle.
-class CycleSpan : public ServoControl {
+class CycleSpan : public test::WrappedControl {
  public:
-  explicit CycleSpan(ServoControl& inner) : inner_(inner) {}
-  ~CycleSpan() override { releaseFromManipulator(); }
-  void attach(Manipulator& m) override {
-    ServoControl::attach(m);
-    if (inner_.getManipulator() != &m) inner_.attach(m);
-  }
-  void activate() override { inner_.activate(); }
+  explicit CycleSpan(ServoControl& inner) : WrappedControl(inner) {}
   void calculate() override {
     const auto cycle = static_cast<long>(dynamic_cast<DefaultManipulator&>(*d_manipulator).getCycleCount());
     if (first.load() < 0) {
@@ -228,34 +209,22 @@ class CycleSpan : public ServoControl {
       first.store(cycle);
     }
     last.store(cycle);
-    inner_.calculate();
+    inner().calculate();
   }
   std::atomic<long> first{-1}, last{-1};
   std::atomic<double> firstSpeed{0};
-
- private:
-  ServoControl& inner_;
 };
 
 // Checks, in the servo thread, that getDesiredJointPosition() is the cycle's own setpoint there.
-class SetpointProbe : public ServoControl {
+class SetpointProbe : public test::WrappedControl {
  public:
-  explicit SetpointProbe(ServoControl& inner) : inner_(inner) {}
-  ~SetpointProbe() override { releaseFromManipulator(); }
-  void attach(Manipulator& m) override {
-    ServoControl::attach(m);
-    if (inner_.getManipulator() != &m) inner_.attach(m);
-  }
-  void activate() override { inner_.activate(); }
+  explicit SetpointProbe(ServoControl& inner) : WrappedControl(inner) {}
   void calculate() override {
     ++cycles;
     if (d_manipulator->getDesiredJointPosition() != d_manipulator->getSetpoint().position) ++different;
-    inner_.calculate();
+    inner().calculate();
   }
   std::atomic<int> cycles{0}, different{0};
-
- private:
-  ServoControl& inner_;
 };
 
 // getDesiredJointPosition(): the setpoint's position, for the servo thread this cycle's, for other
@@ -453,28 +422,19 @@ struct DoNothing : ServoControl {
 
 // Wraps a servo control and records, in its first cycle, the setpoint it is given and the joints
 // read in that cycle.
-class FirstCycle : public ServoControl {
+class FirstCycle : public test::WrappedControl {
  public:
-  explicit FirstCycle(ServoControl& inner) : inner_(inner) {}
-  ~FirstCycle() override { releaseFromManipulator(); }
-  void attach(Manipulator& m) override {
-    ServoControl::attach(m);
-    if (inner_.getManipulator() != &m) inner_.attach(m);
-  }
-  void activate() override { inner_.activate(); }
+  explicit FirstCycle(ServoControl& inner) : WrappedControl(inner) {}
   void calculate() override {
     if (!recorded.load(std::memory_order_relaxed)) {
       setpoint = d_manipulator->getSetpoint().position;
       q = d_manipulator->getJointPosition();
       recorded.store(true, std::memory_order_release);  // the test reads them after this
     }
-    inner_.calculate();
+    inner().calculate();
   }
   JointVector setpoint, q;
   std::atomic<bool> recorded{false};
-
- private:
-  ServoControl& inner_;
 };
 
 // A push of `newtons` along +x at the end-effector for `cycles` cycles while `control` outputs
@@ -944,19 +904,14 @@ TEST_F(ManipulatorTest, UrdfArmLumpsLinksOffTheChainWhereRpCfgSays) {
 
 // Counts the allocations the servo thread makes between two consecutive calculate() calls: the
 // whole cycle (simulation step, limit checks, state publication, log sampling, trajectory).
-class AllocationProbe : public ServoControl {
+class AllocationProbe : public test::WrappedControl {
  public:
-  explicit AllocationProbe(ServoControl& inner) : inner_(inner) {}
-  ~AllocationProbe() override { releaseFromManipulator(); }
-  void attach(Manipulator& m) override {
-    ServoControl::attach(m);
-    if (inner_.getManipulator() != &m) inner_.attach(m);
-  }
+  explicit AllocationProbe(ServoControl& inner) : WrappedControl(inner) {}
   void calculate() override {
     const std::size_t now = test::allocationCount();
     if (cycles_ > 2) allocations_ += now - last_;
     ++cycles_;
-    inner_.calculate();
+    inner().calculate();
     last_ = test::allocationCount();
     if (cycles_ > 2) allocations_ += last_ - now;
     total_.store(allocations_);
@@ -966,7 +921,6 @@ class AllocationProbe : public ServoControl {
   std::uint64_t cycles() const { return cycleCount_.load(); }
 
  private:
-  ServoControl& inner_;
   std::size_t last_ = 0, allocations_ = 0;
   std::uint64_t cycles_ = 0;
   std::atomic<std::uint64_t> cycleCount_{0};

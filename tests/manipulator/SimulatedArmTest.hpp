@@ -29,6 +29,28 @@ class SimulatedArmTest : public ::testing::Test {
   void TearDown() override { simClock().resume(); }
 };
 
+// A servo control that wraps another (the arm's default position control, say): attached and
+// activated with it; a subclass's calculate() observes the cycle and calls inner().calculate().
+class WrappedControl : public ServoControl {
+ public:
+  explicit WrappedControl(ServoControl& inner) : inner_(inner) {}
+  ~WrappedControl() override {
+    withdrawObject();  // first: a system shutdown's thread keeps off from here on (RoboticObject's rule)
+    releaseFromManipulator();
+  }
+  void attach(Manipulator& m) override {
+    ServoControl::attach(m);
+    if (inner_.getManipulator() != &m) inner_.attach(m);
+  }
+  void activate() override { inner_.activate(); }
+
+ protected:
+  ServoControl& inner() { return inner_; }
+
+ private:
+  ServoControl& inner_;
+};
+
 // Outputs a constant torque on one joint (for the first `cycles` cycles if given, then the
 // default position control's output); counts its calls.
 class ConstantTorque : public ServoControl {

@@ -109,19 +109,13 @@ class CosineGenerator : public TrajectoryGenerator {
 
 // Wraps the default control and records, per joint, the largest |q_d - q| and the largest
 // q - q_final past the final target, over the cycles it runs; stops recording after `cycles`.
-class ErrorProbe : public ServoControl {
+class ErrorProbe : public test::WrappedControl {
  public:
   ErrorProbe(ServoControl& inner, std::uint64_t cycles, const JointVector& finalTarget)
-      : inner_(inner), cycles_(cycles), final_(finalTarget) {
+      : WrappedControl(inner), cycles_(cycles), final_(finalTarget) {
     maxError_.setZero(finalTarget.size());
     overshoot_.setZero(finalTarget.size());
   }
-  ~ErrorProbe() override { releaseFromManipulator(); }
-  void attach(Manipulator& m) override {
-    ServoControl::attach(m);
-    if (inner_.getManipulator() != &m) inner_.attach(m);
-  }
-  void activate() override { inner_.activate(); }
   void calculate() override {
     if (count_ < cycles_) {
       const JointVector q = d_manipulator->getJointPosition();
@@ -131,13 +125,12 @@ class ErrorProbe : public ServoControl {
       lastError_ = e;
       if (++count_ == cycles_) done_.store(true);
     }
-    inner_.calculate();
+    inner().calculate();
   }
   bool done() const { return done_.load(); }
   JointVector maxError_, overshoot_, lastError_;
 
  private:
-  ServoControl& inner_;
   std::uint64_t cycles_, count_ = 0;
   JointVector final_;
   std::atomic<bool> done_{false};
