@@ -300,6 +300,18 @@ void SettingSchema::addWord(const std::string& name, const std::string& descript
   add(spec);
 }
 
+void SettingSchema::addWords(const std::string& name, int minCount, int maxCount, const std::string& description,
+                             const std::string& unit) {
+  SettingSpec spec;
+  spec.name = name;
+  spec.kind = SettingKind::Word;
+  spec.minValues = minCount;
+  spec.maxValues = maxCount;
+  spec.unit = unit;
+  spec.description = description;
+  add(spec);
+}
+
 void SettingSchema::addChoice(const std::string& name, const std::vector<std::string>& choices,
                               const std::string& description) {
   SettingSpec spec;

@@ -78,13 +78,7 @@ void Gripper::declareSettings(SettingSchema& schema) {
   PhysicalObject::declareSettings(schema);
   schema.addNumbers("graspRange", 1, "mm", "how close a graspable object must be (simulation)", 0,
                     std::numeric_limits<double>::max());
-  SettingSpec graspable;
-  graspable.name = "graspable";
-  graspable.kind = SettingKind::Word;
-  graspable.minValues = 1;
-  graspable.maxValues = 64;
-  graspable.description = "names of the objects the simulated gripper can pick up";
-  schema.add(graspable);
+  schema.addWords("graspable", 1, 64, "names of the objects the simulated gripper can pick up");
   schema.addNumbers("toolPoint", 3, "mm", "the point midway between the fingertips, in the gripper's frame");
   schema.addNumbers("opening", 1, "mm", "distance between the open fingers (the widest work piece held)", 0,
                     std::numeric_limits<double>::max());

@@ -115,17 +115,11 @@ void UrdfManipulator::declareSettings(SettingSchema& schema) {
   schema.addWord("urdf", "URDF file of the arm");
   schema.addWord("tip", "last link of the chain");
   schema.addWord("packagePath", "folders holding the packages of package:// mesh files, separated by ':'");
-  SettingSpec offChain;
-  offChain.name = "offChainPositions";
-  offChain.kind = SettingKind::Word;
-  offChain.minValues = 1;
-  offChain.maxValues = 64;
-  offChain.unit = "deg or mm";
-  offChain.description =
-      "joint=value pairs: where moving joints off the chain (fingers, a jaw) stand when their links are lumped into "
-      "the arm (revolute in deg, prismatic in mm)";
-  offChain.defaultValue = "(zero within each joint's limits; a mimic joint follows its master)";
-  schema.add(offChain);
+  schema.addWords("offChainPositions", 1, 64,
+                   "joint=value pairs: where moving joints off the chain (fingers, a jaw) stand when their links are lumped "
+                   "into the arm (revolute in deg, prismatic in mm)",
+                   "deg or mm");
+  schema.setDefault("offChainPositions", "(zero within each joint's limits; a mimic joint follows its master)");
   schema.setDefault("urdf", "the constructor's argument");
   schema.setDefault("tip", "the constructor's argument");
   schema.setDefault("packagePath", "(none: ROS_PACKAGE_PATH, then the folders above the URDF file)");

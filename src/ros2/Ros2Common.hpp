@@ -95,13 +95,7 @@ inline dds_entity_t createDomain(int domain, const std::string& config, const st
 
 // Declares the `interfaces` setting (one to 16 words), as the bridge and a remote arm take it.
 inline void addInterfacesSetting(SettingSchema& schema) {
-  SettingSpec interfaces;
-  interfaces.name = "interfaces";
-  interfaces.kind = SettingKind::Word;
-  interfaces.minValues = 1;
-  interfaces.maxValues = 16;
-  interfaces.description = "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice";
-  schema.add(interfaces);
+  schema.addWords("interfaces", 1, 16, "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice");
 }
 
 }  // namespace rp::ros2detail

@@ -386,5 +386,33 @@ TEST(SettingSchema, DefaultsForTheReference) {
   EXPECT_EQ(s.find("display")->defaultValue, "solid");
 }
 
+// addWords(): a list of words with a count range, checked where rp.cfg is read (the gripper's
+// `graspable` list takes 1 to 64 names).
+TEST(SettingSchema, WordListsTakeTheirRangeOfWords) {
+  SettingSchema s;
+  s.addWords("names", 2, 5, "objects", "deg");
+  const SettingSpec* w = s.find("names");
+  ASSERT_NE(w, nullptr);
+  EXPECT_EQ(w->kind, SettingKind::Word);
+  EXPECT_EQ(w->minValues, 2);
+  EXPECT_EQ(w->maxValues, 5);
+  EXPECT_EQ(w->unit, "deg");
+  std::string words;
+  for (int i = 0; i < 65; ++i) words += " piece" + std::to_string(i);
+  const auto message = [](const std::string& graspable) {
+    try {
+      Configuration::parse("[g]\nclass DefaultGripper\ngraspable" + graspable + "\n", "grip.cfg");
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string needs =
+      "grip.cfg:3: setting 'graspable' needs 1 to 64 values (names of the objects the simulated gripper can pick up), got ";
+  EXPECT_EQ(message(words), needs + "65");
+  EXPECT_EQ(message(words.substr(0, words.find(" piece64"))), "no error");
+  EXPECT_EQ(message(""), needs + "0");
+}
+
 }  // namespace
 }  // namespace rp

@@ -112,6 +112,14 @@ class SettingSchema {
   /// @param[in] name         setting name
   /// @param[in] description  meaning of the value
   void addWord(const std::string& name, const std::string& description);
+  /// Declares a setting of `minCount` to `maxCount` words (names, `joint=value` pairs, ...).
+  /// @param[in] name         setting name
+  /// @param[in] minCount     fewest words
+  /// @param[in] maxCount     most words
+  /// @param[in] description  meaning of the words
+  /// @param[in] unit         unit of the values the words carry (may be empty)
+  void addWords(const std::string& name, int minCount, int maxCount, const std::string& description,
+                const std::string& unit = "");
   /// Declares a setting whose one value is a word out of `choices`.
   /// @param[in] name         setting name
   /// @param[in] choices      the allowed words
