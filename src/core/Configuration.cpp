@@ -292,13 +292,7 @@ void SettingSchema::addInteger(const std::string& name, const std::string& descr
   add(spec);
 }
 
-void SettingSchema::addWord(const std::string& name, const std::string& description) {
-  SettingSpec spec;
-  spec.name = name;
-  spec.kind = SettingKind::Word;
-  spec.description = description;
-  add(spec);
-}
+void SettingSchema::addWord(const std::string& name, const std::string& description) { addWords(name, 1, 1, description); }
 
 void SettingSchema::addWords(const std::string& name, int minCount, int maxCount, const std::string& description,
                              const std::string& unit) {
