@@ -50,6 +50,7 @@ class StepGenerator : public TrajectoryGenerator {
 class Probe : public test::WrappedControl {
  public:
   explicit Probe(ServoControl& inner, std::uint64_t recordAt = 0) : WrappedControl(inner), recordAt_(recordAt) {}
+  ~Probe() override { release(); }
   // Track how far each joint goes past `target` (for steps in the positive direction).
   void trackOvershoot(const JointVector& target) {
     target_ = target;
@@ -146,6 +147,7 @@ class RampGenerator : public TrajectoryGenerator {
 class FirstExcess : public test::WrappedControl {
  public:
   FirstExcess(ServoControl& inner, char kind, int joint) : WrappedControl(inner), kind_(kind), joint_(joint) {}
+  ~FirstExcess() override { release(); }
   void calculate() override {
     const int call = calls.load() + 1;
     const ManipulatorModel& model = d_manipulator->getModel();
@@ -202,6 +204,7 @@ TEST_F(ManipulatorTest, PositionViolationIsDetectedInTheCycleItHappens) {
 class CycleSpan : public test::WrappedControl {
  public:
   explicit CycleSpan(ServoControl& inner) : WrappedControl(inner) {}
+  ~CycleSpan() override { release(); }
   void calculate() override {
     const auto cycle = static_cast<long>(dynamic_cast<DefaultManipulator&>(*d_manipulator).getCycleCount());
     if (first.load() < 0) {
@@ -219,6 +222,7 @@ class CycleSpan : public test::WrappedControl {
 class SetpointProbe : public test::WrappedControl {
  public:
   explicit SetpointProbe(ServoControl& inner) : WrappedControl(inner) {}
+  ~SetpointProbe() override { release(); }
   void calculate() override {
     ++cycles;
     if (d_manipulator->getDesiredJointPosition() != d_manipulator->getSetpoint().position) ++different;
@@ -425,6 +429,7 @@ struct DoNothing : ServoControl {
 class FirstCycle : public test::WrappedControl {
  public:
   explicit FirstCycle(ServoControl& inner) : WrappedControl(inner) {}
+  ~FirstCycle() override { release(); }
   void calculate() override {
     if (!recorded.load(std::memory_order_relaxed)) {
       setpoint = d_manipulator->getSetpoint().position;
@@ -907,6 +912,7 @@ TEST_F(ManipulatorTest, UrdfArmLumpsLinksOffTheChainWhereRpCfgSays) {
 class AllocationProbe : public test::WrappedControl {
  public:
   explicit AllocationProbe(ServoControl& inner) : WrappedControl(inner) {}
+  ~AllocationProbe() override { release(); }
   void calculate() override {
     const std::size_t now = test::allocationCount();
     if (cycles_ > 2) allocations_ += now - last_;

@@ -31,13 +31,11 @@ class SimulatedArmTest : public ::testing::Test {
 
 // A servo control that wraps another (the arm's default position control, say): attached and
 // activated with it; a subclass's calculate() observes the cycle and calls inner().calculate().
+// The subclass calls release() in its destructor: there, before any base destructor, the object
+// is still whole for the servo thread's last call and a shutdown's thread.
 class WrappedControl : public ServoControl {
  public:
   explicit WrappedControl(ServoControl& inner) : inner_(inner) {}
-  ~WrappedControl() override {
-    withdrawObject();  // first: a system shutdown's thread keeps off from here on (RoboticObject's rule)
-    releaseFromManipulator();
-  }
   void attach(Manipulator& m) override {
     ServoControl::attach(m);
     if (inner_.getManipulator() != &m) inner_.attach(m);
@@ -46,6 +44,12 @@ class WrappedControl : public ServoControl {
 
  protected:
   ServoControl& inner() { return inner_; }
+  // Withdraws the object (a system shutdown's thread keeps off from here on, RoboticObject's rule)
+  // and waits until no servo cycle uses it.
+  void release() {
+    withdrawObject();
+    releaseFromManipulator();
+  }
 
  private:
   ServoControl& inner_;

@@ -116,6 +116,8 @@ class ErrorProbe : public test::WrappedControl {
     maxError_.setZero(finalTarget.size());
     overshoot_.setZero(finalTarget.size());
   }
+  ~ErrorProbe() override { release(); }
+
   void calculate() override {
     if (count_ < cycles_) {
       const JointVector q = d_manipulator->getJointPosition();
