@@ -107,8 +107,7 @@ struct RemoteManipulator::Impl {
   JointVector qLoop, hold;
   Setpoint setpoint;
   TrajectoryGenerator* activeGenerator = nullptr;
-  std::uint64_t sequence = 0;
-  Stream next{};  // the trajectory this cycle hands to the writer
+  Stream next{};  // the trajectory this cycle hands to the writer (its sequence counts the cycles that wrote one)
 
   std::atomic<TrajectoryGenerator*> generator{nullptr};
   std::atomic<const void*> executing{nullptr};
@@ -269,13 +268,13 @@ void RemoteManipulator::Impl::read(const std::function<void(const std::string&)>
     } catch (const std::exception& e) {
       message = std::string("the remote arm's state: ") + e.what();
     }
-    if (message.empty() && std::chrono::steady_clock::now() - lastReceipt > timeout) {
+    if (message.empty() && !faulted.load() && std::chrono::steady_clock::now() - lastReceipt > timeout) {
       char text[160];
       std::snprintf(text, sizeof text, "no joint_states from %.60s for %.2f s: the remote arm or its process is gone",
                     label.c_str(), options.timeout);
       message = text;
     }
-    if (!message.empty()) fault(message);
+    if (!message.empty() && !faulted.load()) fault(message);  // the first fault only
   }
 }
 
@@ -553,7 +552,7 @@ void RemoteManipulator::control() {
   // The trajectory for the writer thread: the setpoint at kHorizon, then the stop from there at
   // constant deceleration (a cubic with these ends is exactly that) kStopTime later.
   Impl::Stream& out = d.next;
-  out.sequence = ++d.sequence;
+  ++out.sequence;
   const JointVector& qmin = d.model->getPositionMin();
   const JointVector& qmax = d.model->getPositionMax();
   for (int i = 0; i < d.n; ++i) {
