@@ -73,8 +73,8 @@ def bench_arm(title, model, rows, cpp):
     frame, jac, tau = K.Frame(), K.Jacobian(n), K.JntArray(n)
     wrenches = [K.Wrench() for _ in range(chain.getNrOfSegments())]
 
-    # The batched calls twice: each making its result array (whose pages the kernel zeroes and maps
-    # at first touch: about 0.03-0.05 us per row of a 100000-row call), and writing into an array
+    # The batched calls twice: each making its result array (a large one in a buffer the module
+    # kept from the result before, see python/src/ResultBuffers.hpp), and writing into an array
     # made once (out=), as a loop over many batches would.
     fk_out, jac_out, tau_out = np.empty((rows, 4, 4)), np.empty((rows, 6, n)), np.empty((rows, n))
     table = [

@@ -1,6 +1,8 @@
 // Checked numpy conversions of the Python module (Arrays.hpp).
 #include "Arrays.hpp"
 
+#include "ResultBuffers.hpp"
+
 #include <cmath>
 #include <sstream>
 
@@ -97,7 +99,7 @@ std::vector<Transform> toTransforms(const py::handle& value, const char* what) {
 
 py::array_t<double> outputArray(const py::object& out, const std::vector<py::ssize_t>& shape,
                                 std::initializer_list<const py::array*> inputs) {
-  if (out.is_none()) return py::array_t<double>(shape);
+  if (out.is_none()) return newResultArray(shape);
   std::ostringstream want;
   want << '(';
   for (std::size_t i = 0; i < shape.size(); ++i) want << (i ? ", " : "") << shape[i];

@@ -36,7 +36,8 @@ std::vector<Transform> toTransforms(const py::handle& value, const char* what);
 
 /// The array a batched call writes its results into: `out` if the caller gave one (numpy's `out=`
 /// convention: a loop that calls again and again reuses its buffer instead of having a new array
-/// made and its pages first touched each time), else a new array of `shape`.
+/// made and its pages first touched each time), else a new array of `shape` (newResultArray(),
+/// whose large buffers are reused once Python frees them).
 /// @throws py::value_error if `out` is not a writable, C-contiguous float64 ndarray of exactly
 ///         `shape`, or shares memory with one of `inputs`
 py::array_t<double> outputArray(const py::object& out, const std::vector<py::ssize_t>& shape,

@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 
 #include "Bindings.hpp"
+#include "ResultBuffers.hpp"
 #include "rp/core/Configuration.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/io/IoException.hpp"
@@ -18,4 +19,6 @@ PYBIND11_MODULE(_roboticplatform, m) {
   rp::python::bindModels(m);
   rp::python::bindPlatform(m);
   rp::python::bindTrajectories(m);
+  m.def("_kept_result_bytes", &rp::python::keptResultBytes,
+        "Bytes now kept in freed result buffers of the batched calls, for the next large result (tests).");
 }

@@ -7,7 +7,9 @@
   them (no leak either);
 - numpy arrays passed in keep their reference count over many calls, and the arrays returned hold
   no extra references;
-- returned arrays own their data: changing or deleting the source object leaves them as they were.
+- returned arrays own their data: changing or deleting the source object leaves them as they were;
+  a large result's buffer is kept for the next large result once Python frees the array, never
+  while it lives, and what is kept stays within its bound.
 
 The cases that need rp.init() run in their own interpreter (once per process, as in
 test_platform.py)."""
@@ -426,3 +428,47 @@ def test_arm_arrays_and_generator_inputs_keep_their_counts_and_stay_valid():
         print("valid", all(np.array_equal(a, c) for a, c in zip(results, copies)))
     """)
     assert out.split() == ["counts", "True", "own", "True", "valid", "True"], out
+
+
+def test_large_results_reuse_freed_buffers_never_while_alive_and_within_the_bound():
+    # Results of 1 MiB or more come from buffers kept when Python frees an array (so a loop of
+    # large batched calls does not have the kernel zero fresh pages each time); see ResultBuffers.hpp.
+    model = rp.WAMModel(7)
+    rng = np.random.default_rng(3)
+    rows = 20000  # a 20000 x 6 x 7 Jacobian: 6.7 MB
+    Q1, Q2 = rng.uniform(-1, 1, (rows, 7)), rng.uniform(-1, 1, (rows, 7))
+    expected1 = model.jacobian_batch(Q1, out=np.empty((rows, 6, 7)))
+    expected2 = model.jacobian_batch(Q2, out=np.empty((rows, 6, 7)))
+    for r in (0, 777, rows - 1):  # out= itself against single calls
+        np.testing.assert_array_equal(expected2[r], model.jacobian(Q2[r]))
+
+    gc.collect()
+    kept = rp._roboticplatform._kept_result_bytes()
+    J1 = model.jacobian_batch(Q1)
+    J2 = model.jacobian_batch(Q2)
+    assert not np.shares_memory(J1, J2), "two live results share a buffer"
+    np.testing.assert_array_equal(J1, expected1)
+    np.testing.assert_array_equal(J2, expected2)
+    assert sys.getrefcount(J1) == 2 and J1.flags.c_contiguous and J1.flags.writeable and J1.dtype == np.float64
+
+    del J1
+    freed = rp._roboticplatform._kept_result_bytes()
+    assert freed >= kept + rows * 6 * 7 * 8, f"the freed result was not kept: {kept} -> {freed} bytes"
+    # The next result of that size takes the freed buffer, and every value is the new call's.
+    J3 = model.jacobian_batch(Q2)
+    assert rp._roboticplatform._kept_result_bytes() == freed - rows * 6 * 7 * 8, "the freed buffer was not reused"
+    assert not np.shares_memory(J2, J3)
+    np.testing.assert_array_equal(J3, expected2)
+    # A result outlives its model.
+    del model
+    gc.collect()
+    np.testing.assert_array_equal(J3, expected2)
+    del J2, J3
+
+    # Freed results of many sizes: at most 256 MiB stays kept.
+    wam = rp.WAMModel(7)
+    for k in range(12):
+        big = wam.fk_batch(np.zeros((30000 + 5000 * k, 7)))  # 3.8 to 10.9 MB each ... held together:
+        held = [big] + [wam.jacobian_batch(np.zeros((40000 + 1000 * k, 7))) for _ in range(2)]
+        del big, held
+    assert rp._roboticplatform._kept_result_bytes() <= 256 << 20
