@@ -329,23 +329,27 @@ void compositeRigidBody(const ManipulatorModel& model, ManipulatorData& data, bo
     m += l.mass;
     hx += h[0], hy += h[1], hz += h[2];
     xx += Io[0], yy += Io[1], zz += Io[2], xy += Io[3], xz += Io[4], yz += Io[5];
-    double* S = data.motionSubspace[k].data();
+    double S[6];  // in registers: the loop below reads it n - j times
     motionSubspace(model, data, j, S);
+    if constexpr (keepLinks) data.motionSubspace[k] << S[0], S[1], S[2], S[3], S[4], S[5];
     // F = (Io sw + h x sv; m sv - h x sw)
-    double* F = data.inertiaTimesS[k].data();
-    F[0] = xx * S[0] + xy * S[1] + xz * S[2] + (hy * S[5] - hz * S[4]);
-    F[1] = xy * S[0] + yy * S[1] + yz * S[2] + (hz * S[3] - hx * S[5]);
-    F[2] = xz * S[0] + yz * S[1] + zz * S[2] + (hx * S[4] - hy * S[3]);
-    F[3] = m * S[3] - (hy * S[2] - hz * S[1]);
-    F[4] = m * S[4] - (hz * S[0] - hx * S[2]);
-    F[5] = m * S[5] - (hx * S[1] - hy * S[0]);
-    const V6& Sj = data.motionSubspace[k];
-    for (int c = j; c < n; ++c) {
-      const double Mjc = Sj.dot(data.inertiaTimesS[static_cast<std::size_t>(c)]);
+    const double f0 = xx * S[0] + xy * S[1] + xz * S[2] + (hy * S[5] - hz * S[4]);
+    const double f1 = xy * S[0] + yy * S[1] + yz * S[2] + (hz * S[3] - hx * S[5]);
+    const double f2 = xz * S[0] + yz * S[1] + zz * S[2] + (hx * S[4] - hy * S[3]);
+    const double f3 = m * S[3] - (hy * S[2] - hz * S[1]);
+    const double f4 = m * S[4] - (hz * S[0] - hx * S[2]);
+    const double f5 = m * S[5] - (hx * S[1] - hy * S[0]);
+    data.inertiaTimesS[k] << f0, f1, f2, f3, f4, f5;
+    // M_jj from the values in registers (reading F_j back right after storing it stalled each row
+    // on a failed store-to-load forwarding), then the columns of the links beyond j.
+    M[j + j * ld] = (S[0] * f0 + S[1] * f1) + (S[2] * f2 + S[3] * f3) + (S[4] * f4 + S[5] * f5) +
+                    (motorInertia ? model.getArmatureInertia()(j) : 0.0);
+    for (int c = j + 1; c < n; ++c) {
+      const double* Fc = data.inertiaTimesS[static_cast<std::size_t>(c)].data();
+      const double Mjc = (S[0] * Fc[0] + S[1] * Fc[1]) + (S[2] * Fc[2] + S[3] * Fc[3]) + (S[4] * Fc[4] + S[5] * Fc[5]);
       M[j + c * ld] = Mjc;
       M[c + j * ld] = Mjc;
     }
-    if (motorInertia) M[j + j * ld] += model.getArmatureInertia()(j);
   }
 }
 

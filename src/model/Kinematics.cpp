@@ -73,6 +73,10 @@ const Transform& forwardKinematics(const ManipulatorModel& model, ManipulatorDat
     T.row(3) << 0, 0, 0, 1;
     previous = &T;
   }
+  if (model.hasIdentityTool()) {
+    data.endEffector = *previous;
+    return data.endEffector;
+  }
   const Transform& tool = model.getToolTransform();
   data.endEffector.topRows<3>().noalias() = previous->topLeftCorner<3, 3>() * tool.topRows<3>();
   data.endEffector.topRightCorner<3, 1>() += previous->topRightCorner<3, 1>();

@@ -75,6 +75,7 @@ ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters>
   for (JointVector* v : {&qmin_, &qmax_, &vmax_, &amax_, &jmax_, &taumax_, &armature_, &home_, &cosAlpha_, &sinAlpha_}) v->setZero(n);
   if (!base_.allFinite() || !tool_.allFinite() || !gravity_.allFinite())
     throw std::invalid_argument("ManipulatorModel '" + name_ + "': the base, tool or gravity is not finite");
+  toolIsIdentity_ = tool_.isIdentity(0.0);
   placements_.assign(static_cast<std::size_t>(n), Transform::unit());
   placementAxes_.assign(static_cast<std::size_t>(n), PlacementAxes{});
   std::unordered_set<std::string> jointNames, linkNames;

@@ -49,10 +49,6 @@ constexpr std::size_t kLatencies = 4096;
 
 constexpr double kIoWakeup = 0.01;   // the longest sleep of the I/O threads [s]
 
-double wallSeconds() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
 builtin_interfaces_msg_dds__Duration_ duration(double s) {
   builtin_interfaces_msg_dds__Duration_ d{};
   d.sec = static_cast<int32_t>(std::floor(s));
@@ -180,7 +176,7 @@ bool RemoteManipulator::Impl::takeJointStates() {
       }
     }
     if (ours) {
-      const double receipt = wallSeconds();
+      const double receipt = 1e-9 * static_cast<double>(ros2detail::wallNanoseconds());
       const double stamp = js.header.stamp.sec + 1e-9 * js.header.stamp.nanosec;
       {
         std::lock_guard<std::mutex> lock(stateMutex);

@@ -43,21 +43,12 @@ using ros2detail::isIpv4Address;
 using ros2detail::joined;
 using ros2detail::kMaxDomain;
 using ros2detail::rosName;
+using ros2detail::rosTime;
+using ros2detail::wallNanoseconds;
 using ros2detail::validInterface;
 using ros2detail::validNamespace;
 
-std::int64_t wallNanoseconds() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-builtin_interfaces_msg_dds__Time_ now() {
-  const std::int64_t ns = wallNanoseconds();
-  builtin_interfaces_msg_dds__Time_ t{};
-  t.sec = static_cast<int32_t>(ns / 1000000000);
-  t.nanosec = static_cast<uint32_t>(ns % 1000000000);
-  return t;
-}
+builtin_interfaces_msg_dds__Time_ now() { return rosTime(wallNanoseconds()); }
 
 // The wall clock (ROS time) of a control program's real clock: one offset between the two,
 // measured with the program's clock read just before and just after the wall clock (the tightest
@@ -75,11 +66,7 @@ struct WallClockMapping {
     const double age = clockNow - t;
     if (!(age >= 0 && age < 1)) return publishedAt;
     if (&c != clock || !(clockNow - measuredAt < 1.0 && clockNow >= measuredAt)) measure(c);
-    const std::int64_t ns = std::llround(t * 1e9) + offsetNs;
-    builtin_interfaces_msg_dds__Time_ r{};
-    r.sec = static_cast<int32_t>(ns / 1000000000LL);
-    r.nanosec = static_cast<uint32_t>(ns % 1000000000LL);
-    return r;
+    return rosTime(std::llround(t * 1e9) + offsetNs);
   }
 
   void measure(const Clock& c) {

@@ -6,10 +6,13 @@
 #include <dds/dds.h>
 
 #include <cctype>
+#include <chrono>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "builtin_interfaces.h"
 #include "rp/core/Configuration.hpp"
 
 namespace rp::ros2detail {
@@ -96,6 +99,20 @@ inline dds_entity_t createDomain(int domain, const std::string& config, const st
 // Declares the `interfaces` setting (one to 16 words), as the bridge and a remote arm take it.
 inline void addInterfacesSetting(SettingSchema& schema) {
   schema.addWords("interfaces", 1, 16, "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice");
+}
+
+// The wall clock, the source of ROS time [ns since the epoch].
+inline std::int64_t wallNanoseconds() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// A time in nanoseconds since the epoch (not negative) as a ROS Time.
+inline builtin_interfaces_msg_dds__Time_ rosTime(std::int64_t ns) {
+  builtin_interfaces_msg_dds__Time_ t{};
+  t.sec = static_cast<int32_t>(ns / 1000000000);
+  t.nanosec = static_cast<uint32_t>(ns % 1000000000);
+  return t;
 }
 
 }  // namespace rp::ros2detail

@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <numbers>
+#include <vector>
 
 #include "rp/model/Dynamics.hpp"
 #include "rp/model/Kinematics.hpp"
@@ -144,6 +146,33 @@ TEST(Puma560Model, CoriolisAndForwardDynamicsMatchToolbox) {
   coriolisTorque(model, data, kQn, qd, c);
   const Eigen::Matrix<double, 6, 1> expected = C * Eigen::Matrix<double, 6, 1>(qd);
   expectNear(c, expected, 2e-3, "coriolis(qn, qd) * qd");  // the table is rounded to 4 decimals
+}
+
+// The end-effector frame is the last link frame times the tool transform; a tool that is exactly
+// the identity is copied, not multiplied (ManipulatorModel::hasIdentityTool()), and a tool that is
+// anything else, however close to the identity, is applied.
+TEST(Puma560Model, TheEndEffectorIsTheLastLinkTimesTheToolUnlessTheToolIsExactlyTheIdentity) {
+  const Puma560Model puma;
+  std::vector<LinkParameters> links;
+  for (int i = 0; i < puma.getNumberOfJoints(); ++i) links.push_back(puma.getLink(i));
+  Transform tool = Transform::unit();
+  tool.topLeftCorner<3, 3>() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  tool.topRightCorner<3, 1>() << 0.01, -0.02, 0.1;
+  Transform tiny = Transform::unit();
+  tiny(2, 3) = 1e-300;
+  const ManipulatorModel withTool("tool", links, puma.getBaseTransform(), tool, puma.getGravity(), puma.getConvention());
+  const ManipulatorModel almost("almost", links, puma.getBaseTransform(), tiny, puma.getGravity(), puma.getConvention());
+  EXPECT_TRUE(puma.hasIdentityTool());
+  EXPECT_FALSE(withTool.hasIdentityTool());
+  EXPECT_FALSE(almost.hasIdentityTool());
+  ManipulatorData a(puma), b(withTool);
+  const JointVector q = joints({0.1, -0.7, 0.4, 1.1, -0.5, 2.0});
+  const Transform& bare = forwardKinematics(puma, a, q);
+  EXPECT_EQ(bare, a.linkTransforms[5]);
+  const Transform expected = a.linkTransforms[5] * tool;
+  const Transform& tipped = forwardKinematics(withTool, b, q);
+  EXPECT_LT((tipped - expected).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_GT((tipped - bare).cwiseAbs().maxCoeff(), 0.01);
 }
 
 }  // namespace

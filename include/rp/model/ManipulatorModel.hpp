@@ -188,6 +188,9 @@ class ManipulatorModel {
   const Transform& getBaseTransform() const { return base_; }
   /// Pose of the end-effector in the last link frame [m]. Real-time safe: yes.
   const Transform& getToolTransform() const { return tool_; }
+  /// Whether getToolTransform() is exactly the identity (the end-effector frame is the last link
+  /// frame; forward kinematics then copies it instead of multiplying). Real-time safe: yes.
+  bool hasIdentityTool() const { return toolIsIdentity_; }
   /// Gravity in the world frame [m/s^2]. Real-time safe: yes.
   const Vector<3>& getGravity() const { return gravity_; }
 
@@ -249,6 +252,7 @@ class ManipulatorModel {
   std::string name_;
   std::vector<LinkParameters> links_;
   Transform base_, tool_;
+  bool toolIsIdentity_ = false;
   Vector<3> gravity_;
   DHConvention convention_;
   std::vector<Transform> placements_;
