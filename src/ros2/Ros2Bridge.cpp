@@ -6,6 +6,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -13,6 +14,9 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+
+#include <pthread.h>
+#include <sched.h>
 
 #include <nlohmann/json.hpp>
 
@@ -105,6 +109,19 @@ void toQuaternion(const Transform& t, geometry_msgs_msg_dds__Quaternion_& q) {
   q.y = e.y();
   q.z = e.z();
   q.w = e.w();
+}
+
+// The publishing thread's scheduling (Ros2BridgeOptions::priority); a refusal is said once.
+void schedulePublishingThread(int priority) {
+  if (priority <= 0) return;
+  sched_param sp{};
+  sp.sched_priority = priority;
+  if (const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp); err != 0) {
+    static std::atomic<bool> warned{false};
+    if (!warned.exchange(true))
+      std::fprintf(stderr, "rp: Ros2Bridge: cannot use SCHED_FIFO priority %d (%s): its thread runs with normal scheduling\n",
+                   priority, std::strerror(err));
+  }
 }
 
 }  // namespace
@@ -245,6 +262,12 @@ Ros2Bridge::Ros2Bridge(const std::string& name) : FunctionalObject(ClassSection(
       o.interfaces = s->values;
     }
     if (section->find("commands")) o.commands = section->getWord("commands") == "on";
+    if (const ConfigSetting* s = section->find("priority")) {
+      const double p = section->getNumbers("priority").at(0);
+      if (!(p >= 0 && p <= 98) || p != std::floor(p))
+        throw section->errorAt(*s, "setting 'priority' must be a whole number 0 .. 98 (0: normal scheduling)");
+      o.priority = static_cast<int>(p);
+    }
   }
   try {
     start();
@@ -276,6 +299,7 @@ std::string Ros2Bridge::checkOptions(const Ros2BridgeOptions& o) {
   if (!validNamespace(o.nameSpace)) return "namespace '" + o.nameSpace + "' is not a ROS namespace";
   if (!(o.rate == Ros2BridgeOptions::kServoRate || (o.rate >= 1 && o.rate <= 1000)))
     return "rate must be Ros2BridgeOptions::kServoRate or 1 .. 1000 Hz";
+  if (o.priority < 0 || o.priority > 98) return "priority must be 0 (normal scheduling) .. 98";
   if (o.interfaces.empty()) return "interfaces must name at least one interface";
   for (const std::string& v : o.interfaces)
     if (!validInterface(v)) return "'" + v + "' is not an interface name or address";
@@ -294,6 +318,8 @@ void Ros2Bridge::declareSettings(SettingSchema& schema) {
   schema.setDefault("interfaces", "lo");
   schema.addChoice("commands", {"on", "off"}, "take trajectories from each arm's joint_trajectory topic (trajectory_msgs/JointTrajectory)");
   schema.setDefault("commands", "off");
+  schema.addInteger("priority", "SCHED_FIFO priority of the publishing thread (0: normal scheduling)", 0, 98);
+  schema.setDefault("priority", "26");
 }
 
 const Ros2BridgeOptions& Ros2Bridge::getOptions() const noexcept { return impl_->options; }
@@ -405,6 +431,7 @@ void Ros2Bridge::start() {
   if (d.options.rate == Ros2BridgeOptions::kServoRate) {
     // Every servo cycle: woken as executor cycles end (CycleSignal), or every 50 ms without any.
     addThread("ros2bridge", [this](const std::atomic<bool>& stop) {
+      schedulePublishingThread(impl_->options.priority);
       std::uint64_t seen = internal::cyclesEnded();
       while (!stop.load(std::memory_order_acquire)) {
         seen = internal::waitForCycleEnd(seen, 0.05);
@@ -412,7 +439,11 @@ void Ros2Bridge::start() {
       }
     });
   } else {
-    addPeriodicThread("ros2bridge", 1.0 / d.options.rate, [this] { impl_->cycle(); });
+    addPeriodicThread("ros2bridge", 1.0 / d.options.rate, [this, scheduled = false]() mutable {
+      if (!scheduled) schedulePublishingThread(impl_->options.priority);
+      scheduled = true;
+      impl_->cycle();
+    });
   }
 }
 

@@ -10,12 +10,16 @@
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <pthread.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -302,6 +306,59 @@ TEST_F(Ros2BridgeTest, AReaderInAnotherProcessGetsJointStatesAndTheDescription) 
   EXPECT_TRUE(description) << out;
 }
 
+// The scheduling policy and priority of this process's thread named "ros2bridge", once it has
+// one of `policy` (the thread sets its own when it starts), within 5 s.
+std::optional<std::pair<int, int>> bridgeThreadScheduling(int policy) {
+  std::optional<std::pair<int, int>> seen;
+  for (int k = 0; k < 500; ++k) {
+    for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+      std::ifstream comm(task.path() / "comm");
+      std::string name;
+      std::getline(comm, name);
+      if (name != "ros2bridge") continue;
+      const pid_t tid = static_cast<pid_t>(std::stol(task.path().filename().string()));
+      sched_param sp{};
+      if (sched_getparam(tid, &sp) == 0) seen = std::make_pair(sched_getscheduler(tid), sp.sched_priority);
+    }
+    if (seen && seen->first == policy) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return seen;
+}
+
+// The publishing thread runs at its SCHED_FIFO priority (default 26, one below the control loops'
+// 27), in both modes, or with normal scheduling at priority 0.
+TEST_F(Ros2BridgeTest, ThePublishingThreadRunsAtItsPriority) {
+  int probe = 0;
+  std::thread([&probe] {
+    sched_param sp{};
+    sp.sched_priority = 1;
+    probe = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+  }).join();
+  if (probe != 0) GTEST_SKIP() << "this process may not use SCHED_FIFO (" << std::strerror(probe) << ")";
+  EXPECT_EQ(Ros2BridgeOptions{}.priority, 26);
+  const struct {
+    double rate;
+    int priority;
+    int policy;
+  } cases[] = {{Ros2BridgeOptions::kServoRate, 26, SCHED_FIFO}, {20, 12, SCHED_FIFO}, {Ros2BridgeOptions::kServoRate, 0, SCHED_OTHER}};
+  for (const auto& c : cases) {
+    Ros2BridgeOptions o = options_;
+    o.rate = c.rate;
+    o.priority = c.priority;
+    {
+      Ros2Bridge bridge("ros", o);
+      const auto seen = bridgeThreadScheduling(c.policy);
+      ASSERT_TRUE(seen.has_value()) << "no thread named ros2bridge";
+      EXPECT_EQ(seen->first, c.policy) << "rate " << c.rate << ", priority " << c.priority;
+      EXPECT_EQ(seen->second, c.priority) << "rate " << c.rate;
+    }
+  }
+  Ros2BridgeOptions bad = options_;
+  bad.priority = 99;
+  EXPECT_THROW(Ros2Bridge("ros", bad), std::invalid_argument);
+}
+
 TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
   const std::pair<const char*, const char*> cases[] = {
       {"domain 231", "domain"},
@@ -315,6 +372,9 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
       {"interfaces no$such", "interfaces"},
       {"interfaces rpnosuchif0", "interfaces"},
       {"commands maybe", "commands"},
+      {"priority 99", "priority"},
+      {"priority -1", "priority"},
+      {"priority 2.5", "priority"},
   };
   for (const auto& [line, setting] : cases) {
     try {
@@ -329,7 +389,7 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
   }
   // Good settings from rp.cfg are taken.
   configure("[ros]\nclass Ros2Bridge\ndomain " + std::to_string(options_.domain) + "\nnamespace /" + options_.nameSpace +
-            "/\nrate 20\ninterfaces lo\ncommands on\n");
+            "/\nrate 20\ninterfaces lo\ncommands on\npriority 12\n");
   auto* bridge = ObjectManager().createDerivedObject<Ros2Bridge>("ros");
   ASSERT_NE(bridge, nullptr);
   EXPECT_EQ(bridge->getOptions().domain, options_.domain);
@@ -337,6 +397,7 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
   EXPECT_EQ(bridge->getOptions().interfaces, std::vector<std::string>{"lo"});
   EXPECT_EQ(bridge->getClassName(), "Ros2Bridge");
   EXPECT_TRUE(bridge->getOptions().commands);
+  EXPECT_EQ(bridge->getOptions().priority, 12);
   EXPECT_TRUE(bridge->areCommandsEnabled());
   bridge->setCommandsEnabled(false);
   EXPECT_FALSE(bridge->areCommandsEnabled());

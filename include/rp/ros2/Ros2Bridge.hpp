@@ -29,6 +29,12 @@ struct Ros2BridgeOptions {
   /// Whether the arms take trajectories from `<object>/joint_trajectory` (default false: every
   /// trajectory is refused with a message on `<object>/state`); see Ros2Bridge::setCommandsEnabled().
   bool commands = false;
+  /// SCHED_FIFO priority of the publishing thread, 1..98, or 0 for normal scheduling. The default,
+  /// 26, is one below the control loops' default (27): the thread never delays a servo cycle of
+  /// the default priority, and no thread of normal scheduling delays its wake-up (measured with
+  /// bench/dds_bench: about 10 us of the latency from a servo cycle to a remote reader). Used when
+  /// the process may; otherwise one warning on stderr and normal scheduling.
+  int priority = 26;
 };
 
 /// Counters of a running bridge (samples written since it started), for tests and diagnostics.
@@ -81,6 +87,7 @@ struct Ros2BridgeStatistics {
 /// | `rate HZ\|servo` | joint_states and tf rate 1..1000 Hz, or every servo cycle (default 50) |
 /// | `interfaces IF...` | network interfaces for DDS (default `lo`: this machine only; `any`: Cyclone's choice) |
 /// | `commands on\|off` | take trajectories from `<object>/joint_trajectory` (default off) |
+/// | `priority P` | SCHED_FIFO priority of the publishing thread, 0 (normal scheduling) .. 98 (default 26) |
 class Ros2Bridge : public FunctionalObject {
  public:
   /// Creates the bridge from its rp.cfg section (defaults without one) and starts publishing.
