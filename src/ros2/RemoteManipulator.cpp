@@ -264,13 +264,14 @@ void RemoteManipulator::Impl::read(const std::function<void(const std::string&)>
     } catch (const std::exception& e) {
       message = std::string("the remote arm's state: ") + e.what();
     }
-    if (message.empty() && !faulted.load() && std::chrono::steady_clock::now() - lastReceipt > timeout) {
+    if (faulted.load()) continue;  // raiseFault() takes the first fault only
+    if (message.empty() && std::chrono::steady_clock::now() - lastReceipt > timeout) {
       char text[160];
       std::snprintf(text, sizeof text, "no joint_states from %.60s for %.2f s: the remote arm or its process is gone",
                     label.c_str(), options.timeout);
       message = text;
     }
-    if (!message.empty() && !faulted.load()) fault(message);  // the first fault only
+    if (!message.empty()) fault(message);
   }
 }
 

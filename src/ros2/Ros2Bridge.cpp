@@ -262,12 +262,8 @@ Ros2Bridge::Ros2Bridge(const std::string& name) : FunctionalObject(ClassSection(
       o.interfaces = s->values;
     }
     if (section->find("commands")) o.commands = section->getWord("commands") == "on";
-    if (const ConfigSetting* s = section->find("priority")) {
-      const double p = section->getNumbers("priority").at(0);
-      if (!(p >= 0 && p <= 98) || p != std::floor(p))
-        throw section->errorAt(*s, "setting 'priority' must be a whole number 0 .. 98 (0: normal scheduling)");
-      o.priority = static_cast<int>(p);
-    }
+    // A whole number 0 .. 98: the schema (declareSettings()) checked it at the setting's line.
+    if (section->has("priority")) o.priority = static_cast<int>(section->getNumbers("priority").at(0));
   }
   try {
     start();
