@@ -17,6 +17,8 @@
 # - with RP_WEB_ROOT naming another folder it serves that folder's pages (another mark);
 # - each time it ends with status 130 (128 + SIGINT) after SIGINT, as documented;
 # then once more with the build tree in reach: the installed front end is still the one served.
+# And the installed Python module (if built): imported from the moved prefix, it loads the moved
+# library and computes.
 set -euo pipefail
 prefix=$1
 build=$(cd "$2" && pwd -P)
@@ -79,6 +81,26 @@ program=$moved/bin/rp-jointmove
 # The loader finds the library through the program's run path, in the moved prefix.
 lib=$("${launcher[@]}" env -u LD_LIBRARY_PATH ldd "$program" | awk '/libroboticplatform/ {print $3}')
 [[ $lib == "$moved"/* ]] || fail "rp-jointmove loads libroboticplatform from '$lib', not from $moved/lib"
+
+# The Python module, where the build has one (RP_PYTHON): imported from the moved prefix's
+# dist-packages (docs/python.md) with no LD_LIBRARY_PATH, it loads libroboticplatform from the
+# moved prefix through its run path and computes.
+site=$(find "$moved/lib" -maxdepth 3 -type d -name roboticplatform -path '*-packages/*' | head -n 1)
+if [[ -n $site ]]; then
+  # shellcheck disable=SC2016  # expanded by Python
+  py=$("${launcher[@]}" env -u LD_LIBRARY_PATH PYTHONPATH="${site%/roboticplatform}" /usr/bin/python3 -c '
+import roboticplatform as rp
+puma = rp.Puma560Model()
+lib = [l.split()[-1] for l in open("/proc/self/maps") if "libroboticplatform" in l][0]
+print(rp.__file__, lib, round(float(puma.fk(puma.home)[2, 3]), 5))') || fail "the installed Python module does not import"
+  read -r module library z <<<"$py"
+  [[ $module == "$moved"/* ]] || fail "Python imported roboticplatform from $module, not from $moved"
+  [[ $library == "$moved"/* ]] || fail "the Python module loads libroboticplatform from $library, not from $moved/lib"
+  [[ $z == 1.53543 ]] || fail "the installed Python module's Puma end-effector height is $z, not 1.53543"
+  echo "check-relocated: the installed Python module in $site, $([[ ${#launcher[@]} -gt 0 ]] && echo "the build and source trees hidden" || echo "the trees in reach"), loads $library and computes"
+else
+  echo "check-relocated: no Python module installed (RP_PYTHON off): not checked"
+fi
 
 run=$scratch/run
 mkdir "$run"
