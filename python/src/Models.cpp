@@ -123,17 +123,18 @@ py::object makeModelCopy(const ManipulatorModel& model) {
 }
 
 void bindModels(py::module_& m) {
-  py::register_exception<UrdfError>(m, "UrdfError", PyExc_RuntimeError);
+  py::register_exception<UrdfError>(m, "UrdfError", PyExc_RuntimeError).doc() =
+      "A URDF that cannot be loaded: the file and line, or the element, and what is wrong.";
 
   py::class_<PyModel>(m, "Model",
                       "A serial manipulator's kinematic and dynamic model (rp::ManipulatorModel). Joint vectors "
                       "are 1-D float64 arrays of length dof, poses 4 x 4 arrays, SI units.")
-      .def_property_readonly("name", [](const PyModel& p) { return p.model->getName(); })
+      .def_property_readonly("name", [](const PyModel& p) { return p.model->getName(); }, "the model's name")
       .def_property_readonly("dof", &PyModel::dof, "number of joints")
       .def_property_readonly("convention",
                              [](const PyModel& p) {
                                return p.model->getConvention() == DHConvention::Standard ? "standard" : "modified";
-                             })
+                             }, "the link convention: 'standard' (DH) or 'modified' (modified DH and URDF placements)")
       .def_property_readonly("joint_names",
                              [](const PyModel& p) {
                                std::vector<std::string> names;
@@ -148,17 +149,17 @@ void bindModels(py::module_& m) {
                                return names;
                              },
                              "the moving links' names")
-      .def_property_readonly("home", [](const PyModel& p) { return fromVector(p.model->getHomePosition()); })
-      .def_property_readonly("position_min", [](const PyModel& p) { return fromVector(p.model->getPositionMin()); })
-      .def_property_readonly("position_max", [](const PyModel& p) { return fromVector(p.model->getPositionMax()); })
-      .def_property_readonly("velocity_limit", [](const PyModel& p) { return fromVector(p.model->getVelocityLimit()); })
+      .def_property_readonly("home", [](const PyModel& p) { return fromVector(p.model->getHomePosition()); }, "the home joint positions [rad or m]")
+      .def_property_readonly("position_min", [](const PyModel& p) { return fromVector(p.model->getPositionMin()); }, "lower joint limits [rad or m]")
+      .def_property_readonly("position_max", [](const PyModel& p) { return fromVector(p.model->getPositionMax()); }, "upper joint limits [rad or m]")
+      .def_property_readonly("velocity_limit", [](const PyModel& p) { return fromVector(p.model->getVelocityLimit()); }, "joint velocity limits [rad/s or m/s]")
       .def_property_readonly("acceleration_limit",
-                             [](const PyModel& p) { return fromVector(p.model->getAccelerationLimit()); })
-      .def_property_readonly("jerk_limit", [](const PyModel& p) { return fromVector(p.model->getJerkLimit()); })
-      .def_property_readonly("torque_limit", [](const PyModel& p) { return fromVector(p.model->getTorqueLimit()); })
-      .def_property_readonly("base", [](const PyModel& p) { return fromMatrix(p.model->getBaseTransform()); })
-      .def_property_readonly("tool", [](const PyModel& p) { return fromMatrix(p.model->getToolTransform()); })
-      .def_property_readonly("gravity", [](const PyModel& p) { return fromVector(p.model->getGravity()); })
+                             [](const PyModel& p) { return fromVector(p.model->getAccelerationLimit()); }, "joint acceleration limits [rad/s^2 or m/s^2]")
+      .def_property_readonly("jerk_limit", [](const PyModel& p) { return fromVector(p.model->getJerkLimit()); }, "joint jerk limits [rad/s^3 or m/s^3]")
+      .def_property_readonly("torque_limit", [](const PyModel& p) { return fromVector(p.model->getTorqueLimit()); }, "joint torque limits [N m or N]")
+      .def_property_readonly("base", [](const PyModel& p) { return fromMatrix(p.model->getBaseTransform()); }, "the 4 x 4 pose of the base in the world [m]")
+      .def_property_readonly("tool", [](const PyModel& p) { return fromMatrix(p.model->getToolTransform()); }, "the 4 x 4 pose of the end-effector in the last link frame [m]")
+      .def_property_readonly("gravity", [](const PyModel& p) { return fromVector(p.model->getGravity()); }, "gravity in the world frame [m/s^2]")
       .def(
           "link",
           [](const PyModel& p, int i) {
@@ -169,7 +170,7 @@ void bindModels(py::module_& m) {
           py::arg("i"), "the parameters of joint/link i (0-based) as a dict")
       .def(
           "within_limits", [](const PyModel& p, const py::handle& q) { return p.model->isWithinLimits(p.q(q, "q")); },
-          py::arg("q"))
+          py::arg("q"), "whether the joint positions lie within the joint limits")
       .def(
           "fk", [](PyModel& p, const py::handle& q) { return fromMatrix(forwardKinematics(*p.model, p.data, p.q(q, "q"))); },
           py::arg("q"), "pose of the end-effector in the world (4 x 4)")

@@ -136,8 +136,10 @@ void bindPlatform(py::module_& m) {
   m.def("pause", [] { simulatedClock().pause(); }, "Pauses the simulated clock.");
   m.def("resume", [] { simulatedClock().resume(); }, "Lets the simulated clock run (as fast as possible).");
   m.def("time", [] { return RoboticPlatform::getDefaultClock().getTime(); }, "The platform clock's time [s].");
-  m.def("is_shutdown_requested", [] { return ObjectManager::isShutdownRequested(); });
-  m.def("shutdown_reason", [] { return ObjectManager::getShutdownReason(); });
+  m.def("is_shutdown_requested", [] { return ObjectManager::isShutdownRequested(); },
+        "whether a system shutdown (a fault, Ctrl-C) has been requested");
+  m.def("shutdown_reason", [] { return ObjectManager::getShutdownReason(); },
+        "why the system shutdown was requested ('' if none)");
 
   py::class_<Generator, std::unique_ptr<Generator, ReleaseGilDeleter>>(m, "TrajectoryGenerator",
                         "The paper's DefaultTrajectoryGenerator: queued jerk-limited joint and Cartesian motions. "
@@ -163,7 +165,7 @@ void bindPlatform(py::module_& m) {
              const Transform t = toTransform(pose, "pose");
              py::gil_scoped_release release;
              g.moveToThroughJointSpace(t);
-           }, py::arg("pose"))
+           }, py::arg("pose"), "queues a joint-interpolated motion to a 4 x 4 end-effector pose (the inverse kinematics of the arm's model)")
       .def("stop", [](Generator& g, double seconds) {
              py::gil_scoped_release release;
              g.stop(seconds);
@@ -172,48 +174,48 @@ void bindPlatform(py::module_& m) {
              py::gil_scoped_release release;
              return g.waitUntilDone(timeout);
            }, py::arg("timeout") = -1.0, "waits until every queued motion has run; False on time-out or a shutdown")
-      .def("is_done", &Generator::isDone)
+      .def("is_done", &Generator::isDone, "whether every queued motion has been run")
       // These wait for the generator's planning lock, which a queueing thread may hold: without the GIL.
       .def("set_speed_fraction", &Generator::setSpeedFraction, py::arg("fraction"),
-           py::call_guard<py::gil_scoped_release>())
+           py::call_guard<py::gil_scoped_release>(), "fraction (0..1] of the joint limits the motions that follow use")
       .def("set_joint_blend_radius", &Generator::setJointBlendRadius, py::arg("radians"),
-           py::call_guard<py::gil_scoped_release>())
+           py::call_guard<py::gil_scoped_release>(), "blend radius of the joint motions that follow [rad] (0: stop at each point)")
       .def("set_synchronization", [](Generator& g, const std::string& mode) {
              const Synchronization s = synchronizationOf(mode);
              py::gil_scoped_release release;
              g.setSynchronization(s);
            }, py::arg("mode"), "'time' (the default), 'phase' or 'none' (see Planner.set_synchronization)")
       .def("set_cartesian_blend_radius", &Generator::setCartesianBlendRadius, py::arg("metres"),
-           py::call_guard<py::gil_scoped_release>())
+           py::call_guard<py::gil_scoped_release>(), "blend radius of the Cartesian motions that follow [m] (0: stop at each point)")
       .def_property_readonly("blend_count", [](const Generator& g) {
              py::gil_scoped_release release;
              return g.getBlendCount();
-           });
+           }, "the number of via points blended so far (motions joined without stopping)");
 
   py::class_<PyManipulator>(m, "Manipulator",
                             "A manipulator whose servo loop runs in C++ (DefaultManipulator): in simulation mode, "
                             "or behind its hardware server.")
-      .def_property_readonly("name", [](const PyManipulator& p) { return p.get().getName(); })
-      .def_property_readonly("dof", &PyManipulator::dof)
+      .def_property_readonly("name", [](const PyManipulator& p) { return p.get().getName(); }, "the object's name (its rp.cfg section)")
+      .def_property_readonly("dof", &PyManipulator::dof, "number of joints")
       .def_property_readonly(
           "model",
           [](const PyManipulator& p) { return makeModelCopy(p.get().getModel()); },
           "a copy of the model (for its pose now)")
-      .def("joint_position", [](const PyManipulator& p) { return fromVector(p.get().getJointPosition()); })
-      .def("joint_velocity", [](const PyManipulator& p) { return fromVector(p.get().getJointVelocity()); })
+      .def("joint_position", [](const PyManipulator& p) { return fromVector(p.get().getJointPosition()); }, "the joint positions measured in the last servo cycle [rad or m]")
+      .def("joint_velocity", [](const PyManipulator& p) { return fromVector(p.get().getJointVelocity()); }, "the joint velocities of the last servo cycle [rad/s or m/s]")
       .def("desired_joint_position", [](const PyManipulator& p) { return fromVector(p.get().getDesiredJointPosition()); },
            "the setpoint's position the last servo cycle published [rad]")
-      .def("control_output", [](const PyManipulator& p) { return fromVector(p.get().getControlOutput()); })
-      .def("end_effector_transform", [](const PyManipulator& p) { return fromMatrix(p.get().getEndEffectorTransform()); })
-      .def("enable_arm_power", [](const PyManipulator& p) { p.get().enableArmPower(); })
-      .def("disable_arm_power", [](const PyManipulator& p) { p.get().disableArmPower(); })
-      .def_property_readonly("arm_power", [](const PyManipulator& p) { return p.get().isArmPowerOn(); })
+      .def("control_output", [](const PyManipulator& p) { return fromVector(p.get().getControlOutput()); }, "the joint torques the servo loop commanded in its last cycle [N m or N]")
+      .def("end_effector_transform", [](const PyManipulator& p) { return fromMatrix(p.get().getEndEffectorTransform()); }, "the 4 x 4 end-effector pose in the world of the last servo cycle [m]")
+      .def("enable_arm_power", [](const PyManipulator& p) { p.get().enableArmPower(); }, "switches the arm power on (motors enabled, brakes released); the arm holds its position")
+      .def("disable_arm_power", [](const PyManipulator& p) { p.get().disableArmPower(); }, "switches the arm power off (brakes on)")
+      .def_property_readonly("arm_power", [](const PyManipulator& p) { return p.get().isArmPowerOn(); }, "whether the arm power is on")
       .def("set_gravity_compensation", [](const PyManipulator& p, bool on) {
              on ? p.get().setGravityCompensationOn() : p.get().setGravityCompensationOff();
-           }, py::arg("on"))
+           }, py::arg("on"), "switches the servo loop's gravity compensation on or off")
       .def("set_zero_gravity_mode", [](const PyManipulator& p, bool on) {
              on ? p.get().setZeroGravityModeOn() : p.get().setZeroGravityModeOff();
-           }, py::arg("on"))
+           }, py::arg("on"), "on: only the gravity torque goes out (the arm can be pushed by hand); off: the servo control holds again")
       .def("apply_external_wrench", [](const PyManipulator& p, const py::handle& w) {
              const JointVector v = toVector(w, 6, "wrench");
              p.get().applyExternalWrench(Vector<6>(v));
@@ -223,17 +225,17 @@ void bindPlatform(py::module_& m) {
              const auto arm = p.ptr();
              py::gil_scoped_release release;
              arm->setTransform(t);
-           }, py::arg("pose"))
+           }, py::arg("pose"), "places the arm's base at a 4 x 4 pose in the world (allowed while nothing drives the arm)")
       .def("set_simulation_mode", [](const PyManipulator& p, bool on) {
              const auto arm = p.ptr();
              py::gil_scoped_release release;
              on ? arm->setSimulationModeOn() : arm->setSimulationModeOff();
-           }, py::arg("on"))
-      .def_property_readonly("simulation_mode", [](const PyManipulator& p) { return p.get().isSimulationModeOn(); })
-      .def_property_readonly("uses_hardware", [](const PyManipulator& p) { return p.get().usesHardware(); })
-      .def_property_readonly("error_code", [](const PyManipulator& p) { return p.get().getErrorCode(); })
-      .def_property_readonly("error_message", [](const PyManipulator& p) { return p.get().getErrorStatus().message; })
-      .def_property_readonly("cycle_count", [](const PyManipulator& p) { return p.get().getCycleCount(); })
+           }, py::arg("on"), "switches between the simulated arm (True) and the hardware (False), at the next cycle boundary")
+      .def_property_readonly("simulation_mode", [](const PyManipulator& p) { return p.get().isSimulationModeOn(); }, "whether the arm runs in simulation mode")
+      .def_property_readonly("uses_hardware", [](const PyManipulator& p) { return p.get().usesHardware(); }, "whether the arm is reached through a hardware server (simulation mode off)")
+      .def_property_readonly("error_code", [](const PyManipulator& p) { return p.get().getErrorCode(); }, "the object's error code (0: no error)")
+      .def_property_readonly("error_message", [](const PyManipulator& p) { return p.get().getErrorStatus().message; }, "the object's error message ('' if none)")
+      .def_property_readonly("cycle_count", [](const PyManipulator& p) { return p.get().getCycleCount(); }, "the number of servo cycles run")
       .def("parameter", [](const PyManipulator& p, const std::string& name) { return p.get().getParameter(name); },
            py::arg("name"), "the values of a parameter of the servo loop (e.g. 'kp', 'kd', 'ki')")
       .def("set_parameter", [](const PyManipulator& p, const std::string& name, const std::vector<double>& values) {
@@ -247,7 +249,7 @@ void bindPlatform(py::module_& m) {
              std::vector<std::string> names;
              for (const ParameterInfo& info : p.get().getParameters()) names.push_back(info.name);
              return names;
-           })
+           }, "the names of the servo loop's parameters (gains and the like)")
       .def("set_trajectory_generator", [](PyManipulator& p, py::object generator) {
              Generator& g = generator.cast<Generator&>();
              const auto arm = p.ptr();
@@ -264,7 +266,7 @@ void bindPlatform(py::module_& m) {
                arm->clearTrajectoryGenerator();
              }
              p.generator = py::none();
-           })
+           }, "detaches the trajectory generator: the arm holds where it is")
       .def("run_cycles", [](const PyManipulator& p, std::uint64_t cycles) {
              const auto arm = p.ptr();
              py::gil_scoped_release release;
@@ -275,10 +277,12 @@ void bindPlatform(py::module_& m) {
 
   m.def("Puma560", [](const std::string& name) { return make<Puma560>(name); }, py::arg("name") = "",
         "A Puma 560 (simulated unless -nosim and rp.cfg give it a hardware server).");
-  m.def("WAM", [](const std::string& name) { return make<WAM>(name); }, py::arg("name") = "");
+  m.def("WAM", [](const std::string& name) { return make<WAM>(name); }, py::arg("name") = "",
+        "A Barrett WAM, 7 joints or 4 (rp.cfg `links 4`); simulated unless -nosim and rp.cfg give it a hardware server.");
   m.def("UrdfManipulator", [](const std::string& name, const std::string& urdf, const std::string& tip) {
           return make<UrdfManipulator>(name, urdf, tip);
-        }, py::arg("name") = "", py::arg("urdf") = "", py::arg("tip") = "");
+        }, py::arg("name") = "", py::arg("urdf") = "", py::arg("tip") = "",
+        "An arm from a URDF file (urdf) up to its link tip, or as its rp.cfg section says; simulated unless -nosim and a hardware server.");
 
   py::class_<DefaultGripper, std::unique_ptr<DefaultGripper, ReleaseGilDeleter>>(m, "DefaultGripper",
                              "The paper's DefaultGripper: open/close through an I/O board, or simulated.")
@@ -294,12 +298,12 @@ void bindPlatform(py::module_& m) {
       .def("close", [](DefaultGripper& g) {
              py::gil_scoped_release release;
              return g.close();
-           })
+           }, "closes the gripper; False if the hardware refused")
       .def("relax", [](DefaultGripper& g) {
              py::gil_scoped_release release;
              return g.relax();
-           })
-      .def_property_readonly("state", [](const DefaultGripper& g) { return std::string(Gripper::stateName(g.getState())); });
+           }, "neither opens nor closes (the actuator off); False if the hardware refused")
+      .def_property_readonly("state", [](const DefaultGripper& g) { return std::string(Gripper::stateName(g.getState())); }, "the gripper's state: 'open', 'closed', 'relaxed' or 'unknown' (before the first command)");
 
   py::class_<ObjectManager>(m, "ObjectManager", "The paper's object manager.")
       .def(py::init<>())

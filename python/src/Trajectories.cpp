@@ -97,23 +97,23 @@ void bindTrajectories(py::module_& m) {
       .def("move", [](OfflinePlanner& p, const py::handle& degrees) {
              auto& g = p.generator();
              g.move(toVector(degrees, p.getModel().getNumberOfJoints(), "target_degrees"));
-           }, py::arg("target_degrees"))
+           }, py::arg("target_degrees"), "queues a joint motion to the given joint positions [deg]")
       .def("move_radians", [](OfflinePlanner& p, const py::handle& q) {
              auto& g = p.generator();
              g.moveRadians(toVector(q, p.getModel().getNumberOfJoints(), "target"));
-           }, py::arg("target"))
+           }, py::arg("target"), "queues a joint motion to the given joint positions [rad or m]")
       .def("move_to", [](OfflinePlanner& p, const py::handle& pose) { p.generator().moveTo(toTransform(pose, "pose")); },
-           py::arg("pose"))
+           py::arg("pose"), "queues a Cartesian straight-line motion to a 4 x 4 end-effector pose")
       .def("move_to_through_joint_space",
            [](OfflinePlanner& p, const py::handle& pose) { p.generator().moveToThroughJointSpace(toTransform(pose, "pose")); },
-           py::arg("pose"))
-      .def("dwell", &OfflinePlanner::dwell, py::arg("seconds"))
+           py::arg("pose"), "queues a joint-interpolated motion to a 4 x 4 end-effector pose")
+      .def("dwell", &OfflinePlanner::dwell, py::arg("seconds"), "holds still for the given time [s]")
       .def("set_joint_blend_radius", [](OfflinePlanner& p, double r) { p.generator().setJointBlendRadius(r); },
-           py::arg("radians"))
+           py::arg("radians"), "blend radius of the joint motions that follow [rad] (0: stop at each point)")
       .def("set_cartesian_blend_radius", [](OfflinePlanner& p, double r) { p.generator().setCartesianBlendRadius(r); },
-           py::arg("metres"))
+           py::arg("metres"), "blend radius of the Cartesian motions that follow [m] (0: stop at each point)")
       .def("set_speed_fraction", [](OfflinePlanner& p, double f) { p.generator().setSpeedFraction(f); },
-           py::arg("fraction"))
+           py::arg("fraction"), "fraction (0..1] of the joint limits the motions that follow use")
       .def("set_synchronization",
            [](OfflinePlanner& p, const std::string& mode) { p.generator().setSynchronization(synchronizationOf(mode)); },
            py::arg("mode"),

@@ -5,6 +5,7 @@ which have defaults, and equal literal defaults) as pybind11's signatures. So th
 drift from python/src/*.cpp unnoticed."""
 import ast
 import inspect
+import re
 import types
 from pathlib import Path
 
@@ -207,3 +208,31 @@ def test_every_public_member_of_each_class_is_in_the_stubs_and_vice_versa(name):
         pass  # the built-in exception's constructor
     else:
         assert "__init__" not in stubbed, f"{name}: the stubs have a constructor, the module none"
+
+
+def _text_after_signature(doc, name):
+    """A docstring's text besides pybind11's signature lines."""
+    lines = [line.strip() for line in (doc or "").strip().splitlines()]
+    return " ".join(line for line in lines
+                     if line and not line.startswith(name + "(") and line != "Overloaded function."
+                     and not re.match(r"\d+\. " + re.escape(name) + r"\(", line)).strip()
+
+
+def test_every_public_name_and_member_has_a_docstring():
+    # help(), editors and notebooks show these: the C++ documentation's one-line summaries.
+    undocumented = []
+    for name in sorted(n for n in dir(module) if public(n) and not inspect.ismodule(getattr(module, n))):
+        obj = getattr(module, name)
+        if inspect.isclass(obj):
+            if not (obj.__doc__ or "").strip():
+                undocumented.append(name)
+            for member, value in vars(obj).items():
+                if member.startswith("_"):
+                    continue
+                doc = (value.__doc__ or "").strip() if isinstance(value, property) else \
+                    _text_after_signature(getattr(obj, member).__doc__, member)
+                if not doc:
+                    undocumented.append(f"{name}.{member}")
+        elif callable(obj) and not _text_after_signature(obj.__doc__, name):
+            undocumented.append(name)
+    assert not undocumented, f"{len(undocumented)} without a docstring: {undocumented}"
