@@ -13,6 +13,8 @@
 #include "rp/core/ObjectManager.hpp"
 #include "rp/model/Dynamics.hpp"
 #include "rp/io/HwServerIoBoard.hpp"
+#include "rp/ros2/Ros2IoBoard.hpp"
+#include "../ros2/Ros2Common.hpp"
 #include "rp/io/IoException.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/rt/Clock.hpp"
@@ -75,6 +77,42 @@ int firstNonFinite(const JointVector& v) {
     if (!std::isfinite(v(i))) return i;
   return -1;
 }
+
+// Whether rp.cfg wires the arm to hardware: a hardware server, or a remote arm over DDS.
+bool configuresHardware(const ConfigSection* section) {
+  return section != nullptr && (section->has("hwserver") || section->has("remote"));
+}
+
+// The I/O board of a remote arm (rp.cfg `remote NS/OBJECT` and its settings); a bad setting is a
+// ConfigError at its line, a remote arm that does not answer an IoException.
+std::unique_ptr<IoBoard> makeRemoteBoard(const ConfigSection& section, const ManipulatorModel& model) {
+  const ConfigSetting& remote = *section.find("remote");
+  if (const ConfigSetting* hw = section.find("hwserver"))
+    throw section.errorAt(*hw, "an arm is wired to a hardware server (hwserver) or to a remote arm (remote), not both");
+  Ros2IoBoardOptions o;
+  o.remote = section.getWord("remote");
+  if (section.has("domain")) o.domain = static_cast<int>(section.getNumbers("domain").at(0));
+  if (section.has("interfaces")) o.interfaces = section.find("interfaces")->values;
+  if (section.has("timeout")) o.timeout = section.getNumbers("timeout").at(0);
+  if (section.has("connectTimeout")) o.connectTimeout = section.getNumbers("connectTimeout").at(0);
+  if (const std::string why = Ros2IoBoard::checkOptions(o); !why.empty()) {
+    const ConfigSetting* at = &remote;
+    for (const char* key : {"interfaces", "timeout", "connectTimeout"})
+      if (why.rfind(key, 0) == 0 && section.find(key) != nullptr) at = section.find(key);
+    throw section.errorAt(*at, "setting " + why);
+  }
+  std::vector<std::string> joints;
+  std::vector<double> newtonMetresPerVolt;
+  for (int i = 0; i < model.getNumberOfJoints(); ++i) {
+    joints.push_back(model.getJointName(i));
+    newtonMetresPerVolt.push_back(model.getTorqueLimit()(i) / 10.0);  // as writeHardware()'s amplifier: 10 V is the limit
+  }
+  try {
+    return std::make_unique<Ros2IoBoard>(o, joints, newtonMetresPerVolt);
+  } catch (const IoException& e) {
+    throw IoException(section.fileName() + ":" + std::to_string(remote.line) + ": setting 'remote " + o.remote + "': " + e.what());
+  }
+}
 }  // namespace
 
 // The payload of setPayload(): kept for makeSetup() and getPayload...() under setupMutex_, and handed
@@ -104,14 +142,20 @@ std::unique_ptr<DefaultManipulator::Setup> DefaultManipulator::makeSetup(bool si
     const ConfigSection* section = configSection();
     if (board_ != nullptr) {
       setup->keepBoard = true;
-    } else if (section == nullptr || !section->has("hwserver")) {
+    } else if (!configuresHardware(section)) {
       // No hardware: the arm stays unpowered until the program switches it to simulation
       // (setSimulationModeOn() right after the declaration, as the paper's Figure 23 does); see
       // control() and enableArmPower().
       setup->noHardware = true;
     } else {
-      if (section->has("countsPerRadian")) setup->countsPerRadian = section->getNumbers("countsPerRadian").at(0);
-      setup->board = std::make_unique<HwServerIoBoard>(section->getWord("hwserver"));  // throws IoException if absent
+      if (section->has("remote")) {
+        // An arm in another process, driven by torque over DDS (Ros2IoBoard).
+        setup->countsPerRadian = Ros2IoBoard::kCountsPerRadian;
+        setup->board = makeRemoteBoard(*section, *setup->model);
+      } else {
+        if (section->has("countsPerRadian")) setup->countsPerRadian = section->getNumbers("countsPerRadian").at(0);
+        setup->board = std::make_unique<HwServerIoBoard>(section->getWord("hwserver"));  // throws IoException if absent
+      }
       setup->velocity = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
     }
   }
@@ -215,7 +259,7 @@ void DefaultManipulator::physicalSetupChanged() {
   }
   if (!simulation && builtForSimulation_) {
     const ConfigSection* section = configSection();
-    if (section == nullptr || !section->has("hwserver")) throw std::runtime_error(noHardwareMessage());
+    if (!configuresHardware(section)) throw std::runtime_error(noHardwareMessage());
   }
   std::unique_ptr<Setup> setup = makeSetup(simulation, base);  // may throw: nothing changed yet
   if (!isRunning()) {
@@ -662,9 +706,20 @@ void DefaultManipulator::declareSettings(SettingSchema& schema) {
   Manipulator::declareSettings(schema);
   schema.addWord("hwserver", "name of the hardware server the arm is wired to");
   schema.addNumbers("countsPerRadian", 1, "counts/rad", "encoder counts per joint radian");
+  schema.addWord("remote", "the arm runs in another process: its Ros2Bridge's namespace / its object name (NS/OBJECT), "
+                           "driven by torque over DDS (Ros2IoBoard) when simulation is off");
+  schema.addInteger("domain", "with remote: DDS domain id (ROS_DOMAIN_ID) of the remote bridge", 0, ros2detail::kMaxDomain);
+  ros2detail::addInterfacesSetting(schema);
+  schema.addNumbers("timeout", 1, "s", "with remote: silence of the remote arm's joint_states that is a fault", 0.005, 60);
+  schema.addNumbers("connectTimeout", 1, "s", "with remote: longest wait for the remote arm when the hardware is set up", 0.1, 600);
   ManipulatorSimulation::declareSettings(schema);
   schema.setDefault("hwserver", "(none: no hardware, the arm stays unpowered unless simulated)");
-  schema.setDefault("countsPerRadian", "20000");
+  schema.setDefault("countsPerRadian", "20000 (with remote: 1e9, Ros2IoBoard's)");
+  schema.setDefault("remote", "(none)");
+  schema.setDefault("domain", "0");
+  schema.setDefault("interfaces", "lo");
+  schema.setDefault("timeout", "0.1");
+  schema.setDefault("connectTimeout", "10");
 }
 
 bool DefaultManipulator::readHardware(double elapsed) {

@@ -363,16 +363,7 @@ RemoteManipulator::~RemoteManipulator() {
 }
 
 std::string RemoteManipulator::checkOptions(const RemoteManipulatorOptions& o) {
-  const std::size_t slash = o.remote.rfind('/');
-  const std::string object = slash == std::string::npos ? o.remote : o.remote.substr(slash + 1);
-  const std::string ns = slash == std::string::npos ? "" : o.remote.substr(0, slash);
-  if (o.remote.empty() || object.empty() || !ros2detail::validNamespace(ns) || (!ns.empty() && ns.back() == '/') ||
-      ros2detail::rosName(object) != object)
-    return "remote '" + o.remote + "' is not NS/OBJECT (a ROS namespace, then the arm's object name)";
-  if (o.domain < 0 || o.domain > ros2detail::kMaxDomain) return "domain must be 0 .. " + std::to_string(ros2detail::kMaxDomain);
-  if (o.interfaces.empty()) return "interfaces must name at least one interface";
-  for (const std::string& v : o.interfaces)
-    if (!ros2detail::validInterface(v)) return "interfaces: '" + v + "' is not an interface name or address";
+  if (std::string why = ros2detail::checkRemote(o.remote, o.domain, o.interfaces); !why.empty()) return why;
   if (!(o.rate >= 10 && o.rate <= 500)) return "rate must be 10 .. 500 Hz";
   if (!(o.timeout >= 0.05 && o.timeout <= 60)) return "timeout must be 0.05 .. 60 s";
   if (!(o.connectTimeout >= 0.1 && o.connectTimeout <= 600)) return "connectTimeout must be 0.1 .. 600 s";
@@ -397,11 +388,10 @@ void RemoteManipulator::declareSettings(SettingSchema& schema) {
 void RemoteManipulator::connect() {
   Impl& d = *impl_;
   const RemoteManipulatorOptions& o = d.options;
-  const std::size_t slash = o.remote.rfind('/');
-  d.object = slash == std::string::npos ? o.remote : o.remote.substr(slash + 1);
-  d.nameSpace = slash == std::string::npos ? "" : o.remote.substr(0, slash);
-  while (!d.nameSpace.empty() && d.nameSpace.front() == '/') d.nameSpace.erase(0, 1);
-  d.label = d.nameSpace.empty() ? d.object : d.nameSpace + "/" + d.object;
+  const ros2detail::RemoteArm arm = ros2detail::splitRemote(o.remote);
+  d.nameSpace = arm.nameSpace;
+  d.object = arm.object;
+  d.label = arm.label;
   d.domain = ros2detail::createDomain(o.domain, Ros2Bridge::cycloneConfig(o.interfaces), "RemoteManipulator", joined(o.interfaces));
   d.participant = dds_create_participant(static_cast<dds_domainid_t>(o.domain), nullptr, nullptr);
   if (d.participant < 0)

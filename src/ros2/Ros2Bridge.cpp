@@ -22,6 +22,7 @@
 
 #include "../model/ExportFrames.hpp"
 #include "../rt/CycleSignal.hpp"
+#include "EffortCommandControl.hpp"
 #include "Ros2Common.hpp"
 #include "geometry_msgs.h"
 #include "rp/core/ObjectManager.hpp"
@@ -111,20 +112,65 @@ void toQuaternion(const Transform& t, geometry_msgs_msg_dds__Quaternion_& q) {
   q.w = e.w();
 }
 
-// The publishing thread's scheduling (Ros2BridgeOptions::priority); a refusal is said once.
-void schedulePublishingThread(int priority) {
-  if (priority <= 0) return;
-  sched_param sp{};
-  sp.sched_priority = priority;
-  if (const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp); err != 0) {
-    static std::atomic<bool> warned{false};
-    if (!warned.exchange(true))
-      std::fprintf(stderr, "rp: Ros2Bridge: cannot use SCHED_FIFO priority %d (%s): its thread runs with normal scheduling\n",
-                   priority, std::strerror(err));
-  }
-}
-
 }  // namespace
+
+// An arm's effort commands: taken by a listener in Cyclone DDS's receive thread, checked there and
+// handed to the arm's EffortCommandControl at once (the bridge's cycle connects the control to the
+// arm when the first command comes). Kept at one address (the listener's argument).
+struct EffortInput {
+  const std::atomic<bool>* commands = nullptr;  // the bridge's switch
+  std::atomic<std::uint64_t>* acceptedTotal = nullptr;  // the bridge's counters
+  std::atomic<std::uint64_t>* refusedTotal = nullptr;
+  int n = 0;
+  dds_entity_t reader = 0;
+  std::unique_ptr<ros2detail::EffortCommandControl> control;
+  std::atomic<bool> wanted{false};     // a command came: the bridge's cycle connects the control
+  std::atomic<bool> connected{false};  // the control drives the arm (the bridge's thread sets it)
+  std::atomic<std::uint64_t> accepted{0}, refused{0};
+  mutable std::mutex mutex;
+  std::string refusal;  // the last refusal, "" if none
+
+  void refuse(const std::string& why) {
+    ++refused;
+    ++*refusedTotal;
+    std::lock_guard<std::mutex> lock(mutex);
+    refusal = "refused: " + why;
+  }
+  std::string lastRefusal() const {
+    std::lock_guard<std::mutex> lock(mutex);
+    return refusal;
+  }
+  // The listener: every command received.
+  void take() {
+    for (;;) {
+      void* samples[1] = {nullptr};
+      dds_sample_info_t info[1];
+      const dds_return_t count = dds_take(reader, samples, info, 1, 1);
+      if (count <= 0) return;
+      if (info[0].valid_data) {
+        const auto& msg = *static_cast<const std_msgs_msg_dds__Float64MultiArray_*>(samples[0]);
+        if (!commands->load()) {
+          refuse("commands are off (rp.cfg: commands on)");
+        } else if (msg.data._length != static_cast<uint32_t>(n)) {
+          refuse("data: " + std::to_string(msg.data._length) + " efforts, the arm has " + std::to_string(n) + " joints");
+        } else {
+          int bad = -1;
+          for (int i = 0; i < n && bad < 0; ++i)
+            if (!std::isfinite(msg.data._buffer[i])) bad = i;
+          if (bad >= 0) {
+            refuse("data[" + std::to_string(bad) + "] is not a finite number");
+          } else {
+            control->command(msg.data._buffer, n);
+            ++accepted;
+            ++*acceptedTotal;
+            if (!connected.load(std::memory_order_relaxed)) wanted = true;
+          }
+        }
+      }
+      dds_return_loan(reader, samples, count);
+    }
+  }
+};
 
 // One arm as the bridge publishes it.
 struct ArmEntry {
@@ -147,6 +193,15 @@ struct ArmEntry {
   std::unique_ptr<TimedTrajectoryGenerator> generator;  // connected to the arm on the first trajectory taken
   std::string lastCommand;  // the message about the last trajectory (accepted or refused)
   std::uint64_t accepted = 0, refused = 0;
+  std::unique_ptr<EffortInput> effort;  // `<object>/effort_commands`
+
+  // The arm's readers (before the entry goes: no listener runs after).
+  void deleteEndpoints() {
+    dds_delete(stateWriter);
+    dds_delete(descriptionWriter);
+    dds_delete(trajectoryReader);
+    if (effort) dds_delete(effort->reader);
+  }
 };
 
 struct Ros2Bridge::Impl {
@@ -166,6 +221,7 @@ struct Ros2Bridge::Impl {
   std::atomic<std::uint64_t> cycles{0}, jointStatesWritten{0}, tfWritten{0}, descriptions{0}, states{0}, failures{0};
   std::atomic<std::size_t> manipulators{0};
   std::atomic<std::uint64_t> trajectories{0}, trajectoriesRefused{0};
+  std::atomic<std::uint64_t> efforts{0}, effortsRefused{0};  // of every arm (EffortInput counts its own too)
   std::atomic<bool> commands{false};
   std::string bridgeName;
   mutable std::mutex messagesMutex;
@@ -219,6 +275,7 @@ struct Ros2Bridge::Impl {
 
   void addArm(const RoboticObject* o, Manipulator& m, ArmEntry& e);
   void takeTrajectories(Manipulator& m, ArmEntry& e);
+  void connectEffortControl(Manipulator& m, ArmEntry& e);
   std::string executeTrajectory(Manipulator& m, ArmEntry& e, const trajectory_msgs_msg_dds__JointTrajectory_& msg);
   void writeSample(const ManipulatorModel& model, ArmEntry& e, const JointVector& q, const JointVector& qd,
                    const JointVector& tau, const builtin_interfaces_msg_dds__Time_& stamp);
@@ -264,6 +321,7 @@ Ros2Bridge::Ros2Bridge(const std::string& name) : FunctionalObject(ClassSection(
     if (section->find("commands")) o.commands = section->getWord("commands") == "on";
     // A whole number 0 .. 98: the schema (declareSettings()) checked it at the setting's line.
     if (section->has("priority")) o.priority = static_cast<int>(section->getNumbers("priority").at(0));
+    if (section->has("effortTimeout")) o.effortTimeout = section->getNumbers("effortTimeout").at(0);  // range: the schema's
   }
   try {
     start();
@@ -296,6 +354,7 @@ std::string Ros2Bridge::checkOptions(const Ros2BridgeOptions& o) {
   if (!(o.rate == Ros2BridgeOptions::kServoRate || (o.rate >= 1 && o.rate <= 1000)))
     return "rate must be Ros2BridgeOptions::kServoRate or 1 .. 1000 Hz";
   if (o.priority < 0 || o.priority > 98) return "priority must be 0 (normal scheduling) .. 98";
+  if (!(o.effortTimeout >= 0.002 && o.effortTimeout <= 1)) return "effortTimeout must be 0.002 .. 1 s";
   if (o.interfaces.empty()) return "interfaces must name at least one interface";
   for (const std::string& v : o.interfaces)
     if (!validInterface(v)) return "'" + v + "' is not an interface name or address";
@@ -316,6 +375,8 @@ void Ros2Bridge::declareSettings(SettingSchema& schema) {
   schema.setDefault("commands", "off");
   schema.addInteger("priority", "SCHED_FIFO priority of the publishing thread (0: normal scheduling)", 0, 98);
   schema.setDefault("priority", "26");
+  schema.addNumbers("effortTimeout", 1, "s", "effort commands drive an arm this long after the last one, then it holds", 0.002, 1);
+  schema.setDefault("effortTimeout", "0.02");
 }
 
 const Ros2BridgeOptions& Ros2Bridge::getOptions() const noexcept { return impl_->options; }
@@ -331,6 +392,8 @@ Ros2BridgeStatistics Ros2Bridge::getStatistics() const noexcept {
   s.manipulators = impl_->manipulators;
   s.trajectories = impl_->trajectories;
   s.trajectoriesRefused = impl_->trajectoriesRefused;
+  s.efforts = impl_->efforts;
+  s.effortsRefused = impl_->effortsRefused;
   return s;
 }
 
@@ -427,7 +490,7 @@ void Ros2Bridge::start() {
   if (d.options.rate == Ros2BridgeOptions::kServoRate) {
     // Every servo cycle: woken as executor cycles end (CycleSignal), or every 50 ms without any.
     addThread("ros2bridge", [this](const std::atomic<bool>& stop) {
-      schedulePublishingThread(impl_->options.priority);
+      ros2detail::scheduleIoThread(impl_->options.priority, "Ros2Bridge");
       std::uint64_t seen = internal::cyclesEnded();
       while (!stop.load(std::memory_order_acquire)) {
         seen = internal::waitForCycleEnd(seen, 0.05);
@@ -436,7 +499,7 @@ void Ros2Bridge::start() {
     });
   } else {
     addPeriodicThread("ros2bridge", 1.0 / d.options.rate, [this, scheduled = false]() mutable {
-      if (!scheduled) schedulePublishingThread(impl_->options.priority);
+      if (!scheduled) ros2detail::scheduleIoThread(impl_->options.priority, "Ros2Bridge");
       scheduled = true;
       impl_->cycle();
     });
@@ -465,6 +528,22 @@ void Ros2Bridge::Impl::addArm(const RoboticObject* o, Manipulator& m, ArmEntry& 
   writeString(e.descriptionWriter, e.urdf, descriptions);
   e.trajectoryReader = reader(trajectory_msgs_msg_dds__JointTrajectory__desc, e.rosName + "/joint_trajectory");
   e.generator = std::make_unique<TimedTrajectoryGenerator>(bridgeName + "_" + e.rosName + "_joint_trajectory");
+  e.effort = std::make_unique<EffortInput>();
+  e.effort->commands = &commands;
+  e.effort->acceptedTotal = &efforts;
+  e.effort->refusedTotal = &effortsRefused;
+  e.effort->n = n;
+  e.effort->control = std::make_unique<ros2detail::EffortCommandControl>(bridgeName + "_" + e.rosName + "_effort", options.effortTimeout);
+  dds_listener_t* listener = dds_create_listener(e.effort.get());
+  dds_lset_data_available(listener, [](dds_entity_t, void* arg) { static_cast<EffortInput*>(arg)->take(); });
+  {
+    dds_qos_t* qos = ros2detail::rosQos(false);
+    e.effort->reader = dds_create_reader(participant, topic(std_msgs_msg_dds__Float64MultiArray__desc, e.rosName + "/effort_commands"), qos, listener);
+    dds_delete_qos(qos);
+  }
+  dds_delete_listener(listener);
+  if (e.effort->reader < 0)
+    throw std::runtime_error("Ros2Bridge: cannot create a reader on " + e.rosName + "/effort_commands: " + ddsError(e.effort->reader));
   // tf_static: the base, fixed in the world.
   geometry_msgs_msg_dds__TransformStamped_ ts{};
   ts.header.stamp = now();
@@ -557,11 +636,7 @@ void Ros2Bridge::Impl::cycle() {
     auto it = arms.find(r.get());
     if (!full && (it == arms.end() || it->second.name != m->getName())) continue;  // joins in a full cycle
     if (it == arms.end() || it->second.name != m->getName()) {
-      if (it != arms.end()) {  // a new arm at the address of a destroyed one
-        dds_delete(it->second.stateWriter);
-        dds_delete(it->second.descriptionWriter);
-        dds_delete(it->second.trajectoryReader);
-      }
+      if (it != arms.end()) it->second.deleteEndpoints();  // a new arm at the address of a destroyed one
       ArmEntry e;
       addArm(r.get(), *m, e);
       it = arms.insert_or_assign(r.get(), std::move(e)).first;
@@ -599,6 +674,7 @@ void Ros2Bridge::Impl::cycle() {
     if (fresh) writeSample(model, e, q, qd, tau, stamp);
     if (!full) continue;
     takeTrajectories(*m, e);
+    connectEffortControl(*m, e);
 
     // Diagnostics: when they change and once a second.
     const ErrorStatus err = m->getErrorStatus();
@@ -613,7 +689,10 @@ void Ros2Bridge::Impl::cycle() {
                         {"trajectory", e.lastCommand},
                         {"trajectoriesAccepted", e.accepted},
                         {"trajectoriesRefused", e.refused},
-                        {"trajectoryDone", e.generator->isDone()}};
+                        {"trajectoryDone", e.generator->isDone()},
+                        {"effortDriving", e.effort->connected.load() && e.effort->control->isDriving()},
+                        {"effort", e.effort->lastRefusal()},
+                        {"effortsRefused", e.effort->refused.load()}};
     const std::string text = j.dump();
     const auto t = std::chrono::steady_clock::now();
     if (text != e.lastState || t - e.lastStateTime >= std::chrono::seconds(1)) {
@@ -630,9 +709,7 @@ void Ros2Bridge::Impl::cycle() {
   }
   for (auto it = arms.begin(); full && it != arms.end();) {  // arms destroyed since: their writers go
     if (!it->second.seen) {
-      dds_delete(it->second.stateWriter);
-      dds_delete(it->second.descriptionWriter);
-      dds_delete(it->second.trajectoryReader);
+      it->second.deleteEndpoints();
       it = arms.erase(it);
       changed = true;
     } else {
@@ -672,6 +749,25 @@ void Ros2Bridge::Impl::takeTrajectories(Manipulator& m, ArmEntry& e) {
       lastMessages[e.name] = e.lastCommand;
     }
     dds_return_loan(e.trajectoryReader, samples, n);
+  }
+}
+
+// The first effort command of an arm: its EffortCommandControl takes over from the arm's default
+// control (and from the bridge's trajectory generator), unless the arm's program drives it.
+void Ros2Bridge::Impl::connectEffortControl(Manipulator& m, ArmEntry& e) {
+  EffortInput& in = *e.effort;
+  if (!in.wanted.exchange(false) || in.connected.load()) return;
+  TrajectoryGenerator* driving = m.getTrajectoryGenerator();
+  if (driving != nullptr && driving != e.generator.get()) {
+    in.refuse("the arm is driven by a trajectory generator of its program ('" + driving->getName() + "')");
+    return;
+  }
+  try {
+    if (driving != nullptr) m.clearTrajectoryGenerator();
+    m.setServoControl(*in.control);
+    in.connected = true;
+  } catch (const std::exception& x) {
+    in.refuse(x.what());
   }
 }
 
@@ -776,6 +872,10 @@ std::string Ros2Bridge::Impl::executeTrajectory(Manipulator& m, ArmEntry& e,
   // The arm: powered, not shutting down, not driven by a program's generator.
   if (ObjectManager::isShutdownRequested()) return "the system is shutting down";
   if (!m.isArmPowerOn()) return "the arm power is off";
+  if (e.effort->connected.load()) {  // driven by effort commands until now: the default control takes over
+    m.releaseServoControl(*e.effort->control);
+    e.effort->connected = false;
+  }
   TrajectoryGenerator* driving = m.getTrajectoryGenerator();
   if (driving != nullptr && driving != e.generator.get())
     return "the arm follows the program's trajectory generator '" + driving->getName() + "'";

@@ -4,8 +4,13 @@
 // Moved here from Ros2Bridge.cpp; not installed.
 
 #include <dds/dds.h>
+#include <pthread.h>
+#include <sched.h>
 
+#include <atomic>
 #include <cctype>
+#include <cstdio>
+#include <cstring>
 #include <chrono>
 #include <cstdint>
 #include <stdexcept>
@@ -96,6 +101,36 @@ inline dds_entity_t createDomain(int domain, const std::string& config, const st
                            ddsError(d) + " (see Cyclone DDS's message above)");
 }
 
+// A remote arm's address `NS/OBJECT` (`OBJECT` alone without a namespace), split: the namespace
+// without a leading '/', the object, and "NS/OBJECT" for messages.
+struct RemoteArm {
+  std::string nameSpace, object, label;
+};
+inline RemoteArm splitRemote(const std::string& remote) {
+  RemoteArm r;
+  const std::size_t slash = remote.rfind('/');
+  r.object = slash == std::string::npos ? remote : remote.substr(slash + 1);
+  r.nameSpace = slash == std::string::npos ? "" : remote.substr(0, slash);
+  while (!r.nameSpace.empty() && r.nameSpace.front() == '/') r.nameSpace.erase(0, 1);
+  r.label = r.nameSpace.empty() ? r.object : r.nameSpace + "/" + r.object;
+  return r;
+}
+
+// Why a remote arm's address, domain and interfaces cannot be used ("" if they can); the message
+// starts with the setting's name (RemoteManipulator, Ros2IoBoard).
+inline std::string checkRemote(const std::string& remote, int domain, const std::vector<std::string>& interfaces) {
+  const std::size_t slash = remote.rfind('/');
+  const std::string object = slash == std::string::npos ? remote : remote.substr(slash + 1);
+  const std::string ns = slash == std::string::npos ? "" : remote.substr(0, slash);
+  if (remote.empty() || object.empty() || !validNamespace(ns) || (!ns.empty() && ns.back() == '/') || rosName(object) != object)
+    return "remote '" + remote + "' is not NS/OBJECT (a ROS namespace, then the arm's object name)";
+  if (domain < 0 || domain > kMaxDomain) return "domain must be 0 .. " + std::to_string(kMaxDomain);
+  if (interfaces.empty()) return "interfaces must name at least one interface";
+  for (const std::string& v : interfaces)
+    if (!validInterface(v)) return "interfaces: '" + v + "' is not an interface name or address";
+  return "";
+}
+
 // Declares the `interfaces` setting (one to 16 words), as the bridge and a remote arm take it.
 inline void addInterfacesSetting(SettingSchema& schema) {
   schema.addWords("interfaces", 1, 16, "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice");
@@ -113,6 +148,20 @@ inline builtin_interfaces_msg_dds__Time_ rosTime(std::int64_t ns) {
   t.sec = static_cast<int32_t>(ns / 1000000000);
   t.nanosec = static_cast<uint32_t>(ns % 1000000000);
   return t;
+}
+
+// Runs the calling thread (a bridge's publishing thread, a Ros2IoBoard's writer) at SCHED_FIFO
+// `priority` (0: normal scheduling). A refusal is said once per process, on stderr, naming `who`.
+inline void scheduleIoThread(int priority, const char* who) {
+  if (priority <= 0) return;
+  sched_param sp{};
+  sp.sched_priority = priority;
+  if (const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp); err != 0) {
+    static std::atomic<bool> warned{false};
+    if (!warned.exchange(true))
+      std::fprintf(stderr, "rp: %s: cannot use SCHED_FIFO priority %d (%s): its thread runs with normal scheduling\n", who,
+                   priority, std::strerror(err));
+  }
 }
 
 }  // namespace rp::ros2detail

@@ -14,6 +14,8 @@
 #include <thread>
 
 #include "../support/RunProgram.hpp"
+#include "ChildProcess.hpp"
+#include "CountingHold.hpp"
 #include "AllocationCounter.hpp"
 #include "../support/ScratchDirectory.hpp"
 #include "Ros2Fixture.hpp"
@@ -23,68 +25,6 @@
 
 namespace rp::test {
 namespace {
-
-// A program started with fork/exec, its stdout (and stderr) on a pipe.
-struct Child {
-  pid_t pid = -1;
-  int fd = -1;
-  std::string buffered;
-
-  Child(const std::vector<std::string>& argv) {
-    int p[2];
-    if (pipe(p) != 0) return;
-    pid = fork();
-    if (pid == 0) {
-      dup2(p[1], 1);
-      dup2(p[1], 2);
-      close(p[0]);
-      close(p[1]);
-      std::vector<char*> args;
-      for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-      args.push_back(nullptr);
-      execv(args[0], args.data());
-      _exit(127);
-    }
-    close(p[1]);
-    fd = p[0];
-  }
-  ~Child() {
-    if (pid > 0) {
-      kill(pid, SIGKILL);
-      waitpid(pid, nullptr, 0);
-    }
-    if (fd >= 0) close(fd);
-  }
-  // The next line of output ("" at the end).
-  std::string line() {
-    for (;;) {
-      if (const std::size_t nl = buffered.find('\n'); nl != std::string::npos) {
-        std::string l = buffered.substr(0, nl);
-        buffered.erase(0, nl + 1);
-        return l;
-      }
-      char b[512];
-      const ssize_t n = read(fd, b, sizeof b);
-      if (n <= 0) {
-        std::string rest;
-        rest.swap(buffered);
-        return rest;
-      }
-      buffered.append(b, static_cast<std::size_t>(n));
-    }
-  }
-  // Every line until the end, then the exit status (-1: not exited normally).
-  int finish(std::string& output) {
-    for (std::string l = line(); !l.empty() || !buffered.empty(); l = line()) {
-      output.append(l);
-      output.push_back('\n');
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
-    pid = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-};
 
 class RemoteManipulatorTest : public Ros2Fixture {
  protected:
@@ -203,32 +143,6 @@ TEST_F(RemoteManipulatorTest, AVanishedRemoteArmEndsTheProgramWithAnError) {
   EXPECT_TRUE(contains(remote.out, "moving")) << remote.out;
   EXPECT_FALSE(contains(remote.out, "final")) << remote.out;
 }
-
-// A generator that holds `q` and counts, in the loop's thread, the allocations between two of its
-// calls: everything else the loop does in a cycle.
-class CountingHold : public TrajectoryGenerator {
- public:
-  explicit CountingHold(const JointVector& q) : q_(q) {}
-  ~CountingHold() override { withdrawObject(); }  // first: other threads (a shutdown) keep off from here on
-  bool getCurrentSetpoint(double time, Setpoint& setpoint) override {
-    (void)time;
-    const std::size_t now = test::allocationCount();
-    if (calls_ > 2) allocations_ += now - last_;
-    ++calls_;
-    setpoint.position = q_;
-    last_ = test::allocationCount();
-    allocations.store(allocations_);
-    calls.store(calls_);
-    return true;
-  }
-  std::atomic<std::size_t> allocations{0};
-  std::atomic<long> calls{0};
-
- private:
-  const JointVector q_;
-  std::size_t allocations_ = 0, last_ = 0;
-  long calls_ = 0;
-};
 
 // The loop makes no DDS call and does not allocate (the reader and writer threads do the DDS
 // work), while joint states keep coming in and a trajectory goes out each cycle.

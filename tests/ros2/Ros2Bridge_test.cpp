@@ -375,6 +375,8 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
       {"priority 99", "priority"},
       {"priority -1", "priority"},
       {"priority 2.5", "priority"},
+      {"effortTimeout 0.001", "effortTimeout"},
+      {"effortTimeout 2", "effortTimeout"},
   };
   for (const auto& [line, setting] : cases) {
     try {
@@ -389,7 +391,7 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
   }
   // Good settings from rp.cfg are taken.
   configure("[ros]\nclass Ros2Bridge\ndomain " + std::to_string(options_.domain) + "\nnamespace /" + options_.nameSpace +
-            "/\nrate 20\ninterfaces lo\ncommands on\npriority 12\n");
+            "/\nrate 20\ninterfaces lo\ncommands on\npriority 12\neffortTimeout 0.05\n");
   auto* bridge = ObjectManager().createDerivedObject<Ros2Bridge>("ros");
   ASSERT_NE(bridge, nullptr);
   EXPECT_EQ(bridge->getOptions().domain, options_.domain);
@@ -398,6 +400,7 @@ TEST_F(Ros2BridgeTest, BadRpCfgSettingsNameFileAndLine) {
   EXPECT_EQ(bridge->getClassName(), "Ros2Bridge");
   EXPECT_TRUE(bridge->getOptions().commands);
   EXPECT_EQ(bridge->getOptions().priority, 12);
+  EXPECT_EQ(bridge->getOptions().effortTimeout, 0.05);
   EXPECT_TRUE(bridge->areCommandsEnabled());
   bridge->setCommandsEnabled(false);
   EXPECT_FALSE(bridge->areCommandsEnabled());

@@ -77,6 +77,29 @@ class Ros2Fixture : public ::testing::Test {
     return false;
   }
 
+  // A writer of ROS topic `topic` in the bridge's namespace with ROS 2's QoS (reliable, keep-last
+  // 10, XCDR1), once the bridge's reader is matched.
+  dds_entity_t writer(const dds_topic_descriptor_t& desc, const std::string& topic) {
+    if (participant_ <= 0) participant_ = dds_create_participant(static_cast<dds_domainid_t>(options_.domain), nullptr, nullptr);
+    const std::string name = "rt/" + options_.nameSpace + "/" + topic;
+    const dds_entity_t t = dds_create_topic(participant_, &desc, name.c_str(), nullptr, nullptr);
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+    dds_qset_data_representation(qos, 1, &xcdr1);
+    const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
+    dds_delete_qos(qos);
+    EXPECT_GT(w, 0) << name;
+    dds_publication_matched_status_t matched{};
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (dds_get_publication_matched_status(w, &matched) >= 0 && matched.current_count == 0 &&
+           std::chrono::steady_clock::now() < end)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_EQ(matched.current_count, 1u) << "the bridge's reader of " << name << " did not appear";
+    return w;
+  }
+
   Ros2BridgeOptions options_ = uniqueOptions();
   dds_entity_t participant_ = 0;
 };

@@ -32,27 +32,8 @@ class Ros2TrajectoryTest : public test::Ros2Fixture {
     options_.commands = true;
   }
 
-  // A writer of `puma/joint_trajectory` with ROS 2's QoS, once the bridge's reader is matched.
-  dds_entity_t writer() {
-    if (participant_ <= 0) participant_ = dds_create_participant(static_cast<dds_domainid_t>(options_.domain), nullptr, nullptr);
-    const std::string name = "rt/" + options_.nameSpace + "/puma/joint_trajectory";
-    const dds_entity_t t = dds_create_topic(participant_, &trajectory_msgs_msg_dds__JointTrajectory__desc, name.c_str(), nullptr, nullptr);
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
-    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
-    dds_qset_data_representation(qos, 1, &xcdr1);
-    const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
-    dds_delete_qos(qos);
-    EXPECT_GT(w, 0);
-    dds_publication_matched_status_t matched{};
-    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-    while (dds_get_publication_matched_status(w, &matched) >= 0 && matched.current_count == 0 &&
-           std::chrono::steady_clock::now() < end)
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    EXPECT_EQ(matched.current_count, 1u) << "the bridge's reader did not appear";
-    return w;
-  }
+  // A writer of `puma/joint_trajectory`, once the bridge's reader is matched.
+  dds_entity_t writer() { return test::Ros2Fixture::writer(trajectory_msgs_msg_dds__JointTrajectory__desc, "puma/joint_trajectory"); }
 
   // A good trajectory for the Puma from `q0`: three points with positions only over 1.5 s,
   // the joint names in reverse order.

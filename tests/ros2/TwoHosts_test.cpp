@@ -1,7 +1,8 @@
 // Two hosts on one machine: the test makes two network namespaces joined by a veth pair (as two
 // computers on one cable) with `ip`, runs a simulated Puma with a Ros2Bridge restricted to its
 // end of the pair in one namespace (ros2_arm), and rp-dds, or a program driving the arm as a
-// RemoteManipulator (trajectories over the link), in the other; DDS finds the bridge across the
+// RemoteManipulator (trajectories over the link) or the paper's Figure 21 with its Puma560 wired to
+// the arm by rp.cfg (Ros2IoBoard: torques over the link), in the other; DDS finds the bridge across the
 // pair only. Without the privilege to make namespaces (CAP_NET_ADMIN, e.g. not root) every case is
 // skipped with a message saying so.
 #include <gtest/gtest.h>
@@ -17,6 +18,9 @@
 
 #include "RunProgram.hpp"
 #include "ScratchDirectory.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/model/ManipulatorData.hpp"
+#include "rp/model/Puma560Model.hpp"
 
 namespace {
 
@@ -55,6 +59,27 @@ class TwoHosts : public ::testing::Test {
   // rp-dds in namespace b_ with `args`.
   std::pair<std::string, int> rpDdsInB(const std::string& args) {
     return runMerged("ip netns exec " + b_ + " " + RP_DDS_PATH + " " + args + " -domain " + domain_);
+  }
+  // ros2_arm in namespace a_, its bridge on its end of the pair, for 120 s with `args` after that;
+  // null (a failure recorded) if it did not say "ready".
+  FILE* startArmInA(const std::string& args) {
+    FILE* arm = popen(("ip netns exec " + a_ + " " + RP_ROS2_ARM_PATH + " " + domain_ + " " + ns_ + " " + ifA_ + " 120 " + args +
+                       " 2>&1").c_str(), "r");
+    if (arm == nullptr) return nullptr;
+    char line[4096] = "";
+    const bool ready = std::fgets(line, sizeof line, arm) != nullptr && std::string(line) == "ready\n";
+    EXPECT_TRUE(ready) << line;
+    if (!ready) pclose(arm);
+    return ready ? arm : nullptr;
+  }
+  // The arm's output until it ends; its exit status checked.
+  static std::string finishArm(FILE* arm) {
+    char line[4096];
+    std::string rest;
+    while (std::fgets(line, sizeof line, arm)) rest += line;
+    const int armStatus = pclose(arm);
+    EXPECT_TRUE(WIFEXITED(armStatus) && WEXITSTATUS(armStatus) == 0) << rest;
+    return rest;
   }
   std::string skip_;
   bool made_ = false;
@@ -95,21 +120,14 @@ TEST_F(TwoHosts, ARemoteManipulatorOnTheOtherHostDrivesTheArmOverTheLink) {
   const std::string stop = (dir.path() / "stop").string(), config = (dir.path() / "remote.cfg").string();
   std::ofstream(config) << "[leader]\nclass RemoteManipulator\nremote " << ns_ << "/puma\ndomain " << domain_
                         << "\ninterfaces " << ifB_ << "\nconnectTimeout 30\n";
-  FILE* arm = popen(("ip netns exec " + a_ + " " + RP_ROS2_ARM_PATH + " " + domain_ + " " + ns_ + " " + ifA_ +
-                     " 120 commands " + stop + " 2>&1").c_str(), "r");
+  FILE* arm = startArmInA("commands " + stop);
   ASSERT_NE(arm, nullptr);
-  char line[4096] = "";
-  ASSERT_NE(std::fgets(line, sizeof line, arm), nullptr);
-  ASSERT_EQ(std::string(line), "ready\n");
   // `timeout`: a hang ends as a failure (status 137) rather than blocking the suite.
   const auto [out, status] = runMerged("cd " + dir.path().string() + " && ip netns exec " + b_ +
                                        " timeout -s KILL 120 " + REMOTE_MOTION_PATH + " -config " + config + " -nogui");
   EXPECT_EQ(status, 0) << out;
   std::ofstream(stop) << "stop\n";
-  std::string rest;
-  while (std::fgets(line, sizeof line, arm)) rest += line;
-  const int armStatus = pclose(arm);
-  EXPECT_TRUE(WIFEXITED(armStatus) && WEXITSTATUS(armStatus) == 0) << rest;
+  const std::string rest = finishArm(arm);
   const std::vector<double> seen = numbersAfter(out, "final"), actual = numbersAfter(rest, "final");
   ASSERT_EQ(seen.size(), 6u) << out;
   ASSERT_EQ(actual.size(), 6u) << rest;
@@ -125,6 +143,39 @@ TEST_F(TwoHosts, ARemoteManipulatorOnTheOtherHostDrivesTheArmOverTheLink) {
   const std::vector<double> local = numbersAfter(localOut, "final");
   ASSERT_EQ(local.size(), 6u) << localOut;
   for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(actual[i], local[i], 5e-3) << "joint " << i + 1;
+}
+
+// The paper's Figure 21 unchanged on the other host, its Puma560 wired by rp.cfg to the arm over
+// the link (Ros2IoBoard): the program's servo loop drives the arm by torque across the pair.
+TEST_F(TwoHosts, FigureTwentyOneOnTheOtherHostDrivesTheArmByTorqueOverTheLink) {
+  if (!skip_.empty()) GTEST_SKIP() << skip_;
+  rp::test::ScratchDirectory dir("rp_two_hosts_", "torque");
+  const std::string stop = (dir.path() / "stop").string(), config = (dir.path() / "remote.cfg").string();
+  std::ofstream(config) << "[Puma560]\nclass Puma560\nsimulationMode off\nremote " << ns_ << "/puma\ndomain " << domain_
+                        << "\ninterfaces " << ifB_ << "\nconnectTimeout 30\n";
+  FILE* arm = startArmInA("commands " + stop + " servo");
+  ASSERT_NE(arm, nullptr);
+  const auto [out, status] = runMerged("cd " + dir.path().string() + " && ip netns exec " + b_ +
+                                       " timeout -s KILL 120 " + PICK_AND_PLACE_PATH + " -config " + config + " -nogui");
+  EXPECT_EQ(status, 0) << out;
+  std::ofstream(stop) << "stop\n";
+  const std::string rest = finishArm(arm);
+  EXPECT_FALSE(contains(rest, "error")) << rest;
+  const std::vector<double> q = numbersAfter(rest, "final"), seen = numbersAfter(out, "end-effector at");
+  ASSERT_EQ(q.size(), 6u) << "the arm did not come to rest:\n" << rest;
+  ASSERT_EQ(seen.size(), 3u) << out;
+  // Where the task put the end-effector (Figure 21's drop point, 0.6 0.2 0.3 m), read over the
+  // link, is where the arm's own joints put it.
+  rp::Puma560Model puma;
+  rp::ManipulatorData data(puma);
+  rp::JointVector rq(6);
+  for (int i = 0; i < 6; ++i) rq(i) = q[static_cast<std::size_t>(i)];
+  const rp::Transform t = rp::forwardKinematics(puma, data, rq);
+  const double drop[3] = {0.6, 0.2, 0.3};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(t(i, 3), seen[static_cast<std::size_t>(i)], 1e-3) << i << "\n" << out;
+    EXPECT_NEAR(t(i, 3), drop[i], 3e-3) << i << "\n" << out;
+  }
 }
 
 TEST_F(TwoHosts, ABridgeOnAnInterfaceItsHostLacksIsAnErrorNamingIt) {

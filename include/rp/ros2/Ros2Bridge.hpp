@@ -35,6 +35,9 @@ struct Ros2BridgeOptions {
   /// bench/dds_bench: about 10 us of the latency from a servo cycle to a remote reader). Used when
   /// the process may; otherwise one warning on stderr and normal scheduling.
   int priority = 26;
+  /// How long an arm driven by effort commands (`<object>/effort_commands`) goes on with the last
+  /// one [s], 0.002..1: when none came for this long, the arm holds where it is then.
+  double effortTimeout = 0.02;
 };
 
 /// Counters of a running bridge (samples written since it started), for tests and diagnostics.
@@ -48,6 +51,8 @@ struct Ros2BridgeStatistics {
   std::size_t manipulators = 0;     ///< manipulators published in the last cycle
   std::uint64_t trajectories = 0;        ///< trajectory_msgs/JointTrajectory samples accepted (handed to an arm)
   std::uint64_t trajectoriesRefused = 0; ///< trajectory_msgs/JointTrajectory samples refused
+  std::uint64_t efforts = 0;             ///< std_msgs/Float64MultiArray effort commands accepted
+  std::uint64_t effortsRefused = 0;      ///< std_msgs/Float64MultiArray effort commands refused
 };
 
 /// Publishes every manipulator of the process on DDS as ROS 2 does (rmw_cyclonedds conventions:
@@ -61,7 +66,7 @@ struct Ros2BridgeStatistics {
 /// | `tf_static` | tf2_msgs/msg/TFMessage | world to each arm's `<object>_base_link` (transient-local) |
 /// | `robot_description` | std_msgs/msg/String | one URDF holding every arm (transient-local) |
 /// | `<object>/robot_description` | std_msgs/msg/String | the arm's URDF (transient-local) |
-/// | `<object>/state` | std_msgs/msg/String | JSON: arm power, error, system shutdown, the last trajectory accepted or refused; when it changes and once a second |
+/// | `<object>/state` | std_msgs/msg/String | JSON: arm power, error, system shutdown, the last trajectory accepted or refused, effort commands driving the arm or refused; when it changes and once a second |
 ///
 /// It subscribes, per arm, to `<object>/joint_trajectory` (trajectory_msgs/msg/JointTrajectory,
 /// the topic of ros2_control's joint_trajectory_controller), only obeyed when commands are on
@@ -69,6 +74,17 @@ struct Ros2BridgeStatistics {
 /// names, sizes, finite values, times, joint position and velocity limits) and executed by a
 /// TimedTrajectoryGenerator the bridge connects to the arm, replacing the motion under way
 /// continuously; a refused one leaves the arm as it was and names the field on `<object>/state`.
+///
+/// It also subscribes, per arm, to `<object>/effort_commands` (std_msgs/msg/Float64MultiArray:
+/// one torque per joint [N m], as ros2_control's effort forward command controller sends), obeyed
+/// when commands are on: this is how a manipulator of another process drives the arm by torque
+/// (rp.cfg `remote` in that arm's section, Ros2IoBoard). A command is checked as it arrives (the
+/// number of joints, finite values) and drives the arm from its next servo cycle: its torque is
+/// then exactly the command (saturated at the torque limits, with the position and velocity limits
+/// checked as always). The first command connects the bridge's effort control to the arm (within a
+/// publishing cycle); when commands stop for `effortTimeout`, the arm holds where it is then, and
+/// a trajectory taken gives it back to its default control. A refused command leaves the arm as
+/// it was and names the field on `<object>/state` (`effort`, `effortsRefused`).
 ///
 /// The bridge's own thread samples the arms `rate` times a second from the snapshots their servo
 /// threads publish (as the Scene Viewer does): a servo loop never waits for the bridge or the
@@ -88,6 +104,7 @@ struct Ros2BridgeStatistics {
 /// | `interfaces IF...` | network interfaces for DDS (default `lo`: this machine only; `any`: Cyclone's choice) |
 /// | `commands on\|off` | take trajectories from `<object>/joint_trajectory` (default off) |
 /// | `priority P` | SCHED_FIFO priority of the publishing thread, 0 (normal scheduling) .. 98 (default 26) |
+/// | `effortTimeout S` | how long effort commands drive an arm after the last one, 0.002 .. 1 s (default 0.02) |
 class Ros2Bridge : public FunctionalObject {
  public:
   /// Creates the bridge from its rp.cfg section (defaults without one) and starts publishing.
@@ -106,7 +123,7 @@ class Ros2Bridge : public FunctionalObject {
   /// Stops publishing and leaves the DDS domain. Real-time safe: no.
   ~Ros2Bridge() override;
 
-  /// Declares `domain`, `namespace`, `rate`, `interfaces` and `commands`.
+  /// Declares `domain`, `namespace`, `rate`, `interfaces`, `commands`, `priority` and `effortTimeout`.
   /// @param[out] schema  schema to add to
   static void declareSettings(SettingSchema& schema);
 

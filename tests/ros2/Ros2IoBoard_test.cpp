@@ -1,0 +1,253 @@
+// Ros2IoBoard: the paper's Figure 21 (examples/pick_and_place, which declares `Puma560 puma;`) runs
+// unchanged against a Puma in another process (ros2_arm: its Ros2Bridge at the servo rate with
+// commands on), driven by torque over DDS, by changing only rp.cfg. Every exit path is checked
+// against the remote arm, not against this side's flags: the program killed (the arm holds), the
+// remote arm gone, its bridge refusing, a bridge too slow for a torque loop; the servo cycle's
+// allocations; the settings' errors. Every program run here has its exit status checked.
+#include <signal.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <thread>
+
+#include "../support/RunProgram.hpp"
+#include "../support/ScratchDirectory.hpp"
+#include "ChildProcess.hpp"
+#include "CountingHold.hpp"
+#include "Ros2Fixture.hpp"
+#include "rp/model/Kinematics.hpp"
+#include "rp/model/ManipulatorData.hpp"
+#include "rp/model/Puma560Model.hpp"
+#include "rp/ros2/Ros2IoBoard.hpp"
+#include "sensor_msgs.h"
+
+namespace rp::test {
+namespace {
+
+class Ros2IoBoardTest : public Ros2Fixture {
+ protected:
+  void SetUp() override {
+    Ros2Fixture::SetUp();
+    ns_ = options_.nameSpace + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    options_.nameSpace = ns_;  // the fixture's readers: the remote arm's topics
+  }
+  void TearDown() override {
+    Ros2Fixture::TearDown();  // the participant first
+    if (domain_ > 0) dds_delete(domain_);
+  }
+  // The remote arm: ros2_arm with its bridge's commands `on` or off, at `rate` (servo or Hz).
+  std::unique_ptr<Child> startArm(bool commands = true, const std::string& rate = "servo") {
+    auto arm = std::make_unique<Child>(std::vector<std::string>{RP_ROS2_ARM_PATH, std::to_string(options_.domain), ns_, "lo", "120",
+                                                                commands ? "commands" : "nocommands", stopFile(), rate});
+    EXPECT_EQ(arm->line(), "ready");
+    return arm;
+  }
+  std::string stopFile() const { return (dir_ / "stop").string(); }
+  // Stops the arm (the stop file) and returns its output; checks its exit status.
+  std::string stopArm(Child& arm) {
+    std::ofstream(stopFile()) << "stop\n";
+    std::string out;
+    EXPECT_EQ(arm.finish(out), 0) << out;
+    return out;
+  }
+  std::string writeConfig(const std::string& name, const std::string& text) {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path) << text;
+    return path;
+  }
+  // Figure 21's unnamed Puma560 (its class section) wired to the remote arm.
+  std::string remoteConfig(const std::string& extra = "") {
+    return writeConfig("remote.cfg", "[Puma560]\nclass Puma560\nsimulationMode off\nremote " + ns_ + "/puma\ndomain " +
+                                         std::to_string(options_.domain) + "\nconnectTimeout 30\n" + extra);
+  }
+  Outcome run(const std::string& config) {
+    // `timeout`: a hang ends as status 124 (a failure) rather than blocking the suite.
+    return runProgram("timeout -s KILL 120 " + std::string(PICK_AND_PLACE_PATH) + " -config " + config + " -nogui",
+                      (dir_ / "run").string());
+  }
+  // Waits (at most `seconds`) for a joint_states sample of the remote arm for which `accept` holds.
+  bool waitForJoints(const std::function<bool(const JointVector& q, const JointVector& qd)>& accept, double seconds) {
+    if (jointStates_ == 0) {
+      // The domain on loopback, as ros2_arm's bridge has it (Cyclone's default interface may not be lo).
+      domain_ = dds_create_domain(static_cast<dds_domainid_t>(options_.domain), Ros2Bridge::cycloneConfig({"lo"}).c_str());
+      EXPECT_GT(domain_, 0);
+      jointStates_ = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
+    }
+    return takeUntil<sensor_msgs_msg_dds__JointState_>(
+        jointStates_,
+        [&](const sensor_msgs_msg_dds__JointState_& js) {
+          if (js.position._length != 6 || js.velocity._length != 6) return false;
+          JointVector q(6), qd(6);
+          for (int i = 0; i < 6; ++i) {
+            q(i) = js.position._buffer[i];
+            qd(i) = js.velocity._buffer[i];
+          }
+          return accept(q, qd);
+        },
+        seconds);
+  }
+
+  ScratchDirectory dir_{"rp_ros2_board_test_", "scratch"};
+  std::string ns_;
+  dds_entity_t domain_ = 0, jointStates_ = 0;
+};
+
+// Figure 21 unchanged: the remote arm does the task, driven by the program's own servo loop.
+TEST_F(Ros2IoBoardTest, PickAndPlaceRunsUnchangedAgainstAnArmInAnotherProcess) {
+  const Outcome local = run(writeConfig("local.cfg", "[Puma560]\nclass Puma560\n"));
+  ASSERT_EQ(local.status, 0) << local.err;
+  auto arm = startArm();
+  const Outcome remote = run(remoteConfig());
+  EXPECT_EQ(remote.status, 0) << remote.out << remote.err;
+  const std::string armOut = stopArm(*arm);
+  EXPECT_FALSE(contains(armOut, "error")) << armOut;
+  const std::vector<double> q = numbersAfter(armOut, "final");
+  ASSERT_EQ(q.size(), 6u) << "the remote arm did not come to rest:\n" << armOut;
+
+  // The task's outcome as the simulated arm's: the end-effector and the work piece where the
+  // program left them, to the settling of two servo loops (the remote one has up to two cycles of
+  // delay) and the piece's fall (it bounces on the table).
+  const std::vector<double> le = numbersAfter(local.out, "end-effector at"), re = numbersAfter(remote.out, "end-effector at");
+  const std::vector<double> lp = numbersAfter(local.out, "work piece at"), rpiece = numbersAfter(remote.out, "work piece at");
+  ASSERT_EQ(le.size(), 3u) << local.out;
+  ASSERT_EQ(re.size(), 3u) << remote.out;
+  ASSERT_EQ(rpiece.size(), 3u) << remote.out;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(re[i], le[i], 2e-3) << "end-effector " << i << "\n" << remote.out;
+    EXPECT_NEAR(rpiece[i], lp[i], 5e-3) << "work piece " << i << "\n" << remote.out;
+  }
+  // The remote arm is really there: its own final joints, through the Puma's model, put the
+  // end-effector where the program read it over DDS.
+  Puma560Model puma;
+  ManipulatorData data(puma);
+  JointVector rq(6);
+  for (int i = 0; i < 6; ++i) rq(i) = q[static_cast<std::size_t>(i)];
+  const Transform t = forwardKinematics(puma, data, rq);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(t(i, 3), re[static_cast<std::size_t>(i)], 1e-3) << i << "\n" << armOut;
+  EXPECT_NEAR(t(2, 2), -1, 1e-3) << "the gripper points down";
+}
+
+// SIGKILL mid-motion: no more effort commands, and the remote bridge holds the arm where it is.
+TEST_F(Ros2IoBoardTest, KillingTheProgramLeavesTheRemoteArmHolding) {
+  auto arm = startArm();
+  Child program({PICK_AND_PLACE_PATH, "-config", remoteConfig(), "-nogui"});
+  // The remote arm moving fast, under the program's torques.
+  ASSERT_TRUE(waitForJoints([](const JointVector&, const JointVector& qd) { return qd.cwiseAbs().maxCoeff() > 0.2; }, 60))
+      << "the remote arm never moved";
+  kill(program.pid, SIGKILL);
+  std::string out;
+  EXPECT_EQ(program.finish(out), -1) << out;
+  // Held within a fraction of a second (effortTimeout 0.02 s, then the hold's braking); then
+  // still, 0.5 s later at the same place: held, not falling.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  JointVector held;
+  ASSERT_TRUE(waitForJoints(
+      [&](const JointVector& q, const JointVector& qd) {
+        held = q;
+        return qd.cwiseAbs().maxCoeff() < 1e-3;
+      },
+      5))
+      << "the remote arm did not stop";
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_TRUE(waitForJoints([&](const JointVector& q, const JointVector&) { return (q - held).cwiseAbs().maxCoeff() < 1e-3; }, 1))
+      << "the remote arm moved on";
+  const std::string armOut = stopArm(*arm);
+  EXPECT_FALSE(contains(armOut, "error")) << armOut;
+  EXPECT_TRUE(contains(armOut, "final")) << armOut;
+}
+
+// The remote arm's process killed mid-motion: the program shuts down, naming it.
+TEST_F(Ros2IoBoardTest, AVanishedRemoteArmShutsTheProgramDown) {
+  auto arm = startArm();
+  Child program({PICK_AND_PLACE_PATH, "-config", remoteConfig(), "-nogui"});
+  ASSERT_TRUE(waitForJoints([](const JointVector&, const JointVector& qd) { return qd.cwiseAbs().maxCoeff() > 0.2; }, 60));
+  kill(arm->pid, SIGKILL);
+  std::string out;
+  EXPECT_EQ(program.finish(out), RoboticPlatform::kExitAfterShutdown) << out;
+  EXPECT_TRUE(contains(out, "no joint_states from " + ns_ + "/puma")) << out;
+  EXPECT_TRUE(contains(out, "stopped by a system shutdown")) << out;
+}
+
+// The remote bridge refuses the effort commands (its commands are off): a shutdown naming why.
+TEST_F(Ros2IoBoardTest, TheRemoteBridgesRefusalShutsTheProgramDown) {
+  auto arm = startArm(false);
+  const Outcome r = run(remoteConfig());
+  EXPECT_EQ(r.status, RoboticPlatform::kExitAfterShutdown) << r.out << r.err;
+  EXPECT_TRUE(contains(r.err, "the remote arm " + ns_ + "/puma refused the effort commands: commands are off")) << r.err;
+  const std::string armOut = stopArm(*arm);
+  EXPECT_FALSE(contains(armOut, "error")) << armOut;
+  EXPECT_TRUE(contains(armOut, "final")) << "the remote arm held still:\n" << armOut;
+}
+
+// A remote bridge publishing at 100 Hz cannot carry a torque loop: refused at construction,
+// naming the setting's line and the remedy.
+TEST_F(Ros2IoBoardTest, ABridgeSlowerThanTheServoRateIsRefused) {
+  auto arm = startArm(true, "100");
+  const Outcome r = run(remoteConfig());
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(contains(r.err, "remote.cfg:4: setting 'remote " + ns_ + "/puma'")) << r.err;
+  EXPECT_TRUE(contains(r.err, "rate servo")) << r.err;
+  stopArm(*arm);
+}
+
+// In this process: the servo cycle of an arm on the board makes no DDS call and does not allocate,
+// while joint states come in and an effort command goes out each cycle.
+TEST_F(Ros2IoBoardTest, TheServoCycleDoesNotAllocate) {
+  auto arm = startArm();
+  RoboticPlatform::setSimulationModeOff();
+  configure("[leader]\nclass Puma560\nsimulationMode off\nremote " + ns_ + "/puma\ndomain " + std::to_string(options_.domain) +
+            "\nconnectTimeout 30\n");
+  {
+    Puma560 puma("leader");
+    ASSERT_TRUE(puma.usesHardware());
+    puma.enableArmPower();
+    CountingHold hold(puma.getJointPosition());
+    puma.setTrajectoryGenerator(hold);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (hold.calls.load() < 500 && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ASSERT_GE(hold.calls.load(), 500);
+    EXPECT_EQ(hold.allocations.load(), 0u) << "over " << hold.calls.load() << " cycles";
+    EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+    puma.clearTrajectoryGenerator();
+  }
+  ASSERT_TRUE(waitForJoints([](const JointVector&, const JointVector& qd) { return qd.cwiseAbs().maxCoeff() < 1e-3; }, 5));
+  const std::string armOut = stopArm(*arm);
+  EXPECT_FALSE(contains(armOut, "error")) << armOut;
+}
+
+TEST_F(Ros2IoBoardTest, SettingsErrorsNameTheFileAndLine) {
+  RoboticPlatform::setSimulationModeOff();
+  auto expectError = [&](const std::string& cfg, const std::string& where, const std::string& what) {
+    configure(cfg);
+    try {
+      Puma560 puma("leader");
+      ADD_FAILURE() << "no error for\n" << cfg;
+    } catch (const std::exception& e) {
+      EXPECT_TRUE(contains(e.what(), where)) << e.what();
+      EXPECT_TRUE(contains(e.what(), what)) << e.what();
+    }
+  };
+  expectError("[leader]\nclass Puma560\nsimulationMode off\nremote a//b\n", "test.cfg:4", "is not NS/OBJECT");
+  expectError("[leader]\nclass Puma560\nsimulationMode off\nremote cell/puma\nhwserver hw0\n", "test.cfg:5", "not both");
+  // Nobody there: waited for a bounded time; the error names the topic.
+  expectError("[leader]\nclass Puma560\nsimulationMode off\nremote " + ns_ + "/nobody\ndomain " + std::to_string(options_.domain) +
+                  "\nconnectTimeout 0.3\n",
+              "test.cfg:4", "rt/" + ns_ + "/joint_states");
+  // Out of range: refused by the settings' schema at the setting's line.
+  for (const char* line : {"timeout 0.001", "connectTimeout 0", "domain 231", "interfaces no$such"}) {
+    try {
+      configure(std::string("[leader]\nclass Puma560\nsimulationMode off\nremote cell/puma\n") + line + "\n");
+      ObjectManager().createDerivedObject<Puma560>("leader");
+      ADD_FAILURE() << line << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_TRUE(contains(e.what(), "test.cfg:5")) << line << ": " << e.what();
+    }
+    ObjectManager().deleteAllObjects();
+  }
+  EXPECT_THROW(Ros2IoBoard(Ros2IoBoardOptions{}, {"joint1"}, {1.0}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rp::test
