@@ -83,6 +83,19 @@ bool configuresHardware(const ConfigSection* section) {
   return section != nullptr && (section->has("hwserver") || section->has("remote"));
 }
 
+// The settings that belong to a remote arm are refused without `remote`, and countsPerRadian with
+// it (the remote board's counts are its own): a setting that would be ignored is a mistake.
+void checkRemoteSettings(const ConfigSection& section) {
+  const bool remote = section.has("remote");
+  for (const char* key : {"domain", "interfaces", "timeout", "connectTimeout"})
+    if (!remote)
+      if (const ConfigSetting* s = section.find(key))
+        throw section.errorAt(*s, std::string("setting '") + key + "' is for an arm in another process: add 'remote NS/OBJECT'");
+  if (remote)
+    if (const ConfigSetting* s = section.find("countsPerRadian"))
+      throw section.errorAt(*s, "setting 'countsPerRadian' is not for a remote arm (its joint_states are in radians)");
+}
+
 // The I/O board of a remote arm (rp.cfg `remote NS/OBJECT` and its settings); a bad setting is a
 // ConfigError at its line, a remote arm that does not answer an IoException.
 std::unique_ptr<IoBoard> makeRemoteBoard(const ConfigSection& section, const ManipulatorModel& model) {
@@ -135,6 +148,7 @@ struct DefaultManipulator::Setup {
 };
 
 std::unique_ptr<DefaultManipulator::Setup> DefaultManipulator::makeSetup(bool simulation, const Transform& base) const {
+  if (const ConfigSection* section = configSection()) checkRemoteSettings(*section);
   auto setup = std::make_unique<Setup>();
   setup->model = modelFactory_(base);
   if (!setup->model) throw std::invalid_argument("DefaultManipulator '" + getName() + "': no model");
@@ -306,7 +320,8 @@ void DefaultManipulator::physicalSetupChanged() {
       throw std::logic_error("manipulator '" + getName() +
                              "': the arm must be at rest to leave the hardware (its amplifiers go off)");
     case SetupResult::kHardwareFailed:
-      throw IoException("manipulator '" + getName() + "': the hardware server does not answer: cannot read the joints");
+      throw IoException("manipulator '" + getName() + "': the hardware (rp.cfg '" + std::string(configSection() && configSection()->has("remote") ? "remote" : "hwserver") +
+                        "') does not answer: cannot read the joints");
   }
   builtForSimulation_ = simulation;
   builtBase_ = base;
@@ -729,16 +744,18 @@ bool DefaultManipulator::readHardware(double elapsed) {
   // A server descheduled for a few cycles otherwise shows the joints standing still (velocity 0,
   // and the servo control pushes) and then jumping (a spike, a false velocity fault).
   std::int64_t sampled = -1;
+  JointVector q = q_;  // the joints of one sample, taken into q_ only once the sample is known whole
   for (int attempt = 0; attempt < 8 && sampled < 0; ++attempt) {
     const std::int64_t before = board_->inputSampleTime();
-    for (int i = 0; i < q_.size(); ++i) {  // read even while a sample is stored: a failure shows
+    for (int i = 0; i < q.size(); ++i) {  // read even while a sample is stored: a failure shows
       std::int64_t counts = 0;
       if (board_->readEncoder(i, counts) != IoStatus::kOk) return false;
-      if (before >= 0) q_(i) = static_cast<double>(counts) / countsPerRadian_;
+      q(i) = static_cast<double>(counts) / countsPerRadian_;
     }
     if (before >= 0 && board_->inputSampleTime() == before) sampled = before;
   }
   if (sampled < 0) return true;  // the server was storing a sample each time: none new this cycle
+  q_ = q;
   if (sampled > 0) {
     if (sampled == lastSampleTime_) return true;  // no new sample: position and velocity as they were
     if (lastSampleTime_ > 0) elapsed = static_cast<double>(sampled - lastSampleTime_) * 1e-9;

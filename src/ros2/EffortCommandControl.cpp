@@ -1,5 +1,6 @@
 #include "EffortCommandControl.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -35,20 +36,26 @@ void EffortCommandControl::attach(Manipulator& manipulator) {
 }
 
 void EffortCommandControl::command(const double* torques, int n) noexcept {
+  // A sequence lock without fences (ThreadSanitizer has none): stores with release after the odd
+  // count, loads with acquire before the second look at it.
   sequence_.fetch_add(1, std::memory_order_relaxed);  // odd: storing
-  std::atomic_thread_fence(std::memory_order_release);
-  for (int i = 0; i < n && i < kMaxJoints; ++i) torques_[static_cast<std::size_t>(i)].store(torques[i], std::memory_order_relaxed);
-  received_.store(steadyNanoseconds(), std::memory_order_relaxed);
+  for (int i = 0; i < n && i < kMaxJoints; ++i) torques_[static_cast<std::size_t>(i)].store(torques[i], std::memory_order_release);
+  received_.store(steadyNanoseconds(), std::memory_order_release);
   sequence_.fetch_add(1, std::memory_order_release);  // even: stored
+}
+
+void EffortCommandControl::release() noexcept {
+  sequence_.fetch_add(1, std::memory_order_relaxed);
+  received_.store(0, std::memory_order_release);
+  sequence_.fetch_add(1, std::memory_order_release);
 }
 
 bool EffortCommandControl::latest(double* torques, int n, std::int64_t& received) const noexcept {
   for (int attempt = 0; attempt < 8; ++attempt) {
     const std::uint64_t before = sequence_.load(std::memory_order_acquire);
     if (before & 1u) continue;
-    for (int i = 0; i < n; ++i) torques[i] = torques_[static_cast<std::size_t>(i)].load(std::memory_order_relaxed);
-    received = received_.load(std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_acquire);
+    for (int i = 0; i < n; ++i) torques[i] = torques_[static_cast<std::size_t>(i)].load(std::memory_order_acquire);
+    received = received_.load(std::memory_order_acquire);
     if (sequence_.load(std::memory_order_relaxed) == before) return true;
   }
   return false;  // the receive thread kept storing: this cycle holds
@@ -66,8 +73,14 @@ void EffortCommandControl::calculate() {
   const int n = static_cast<int>(q.size());
   double torques[kMaxJoints];
   std::int64_t received = 0;
-  const bool fresh = latest(torques, n, received) && received != 0 &&
-                     1e-9 * static_cast<double>(steadyNanoseconds() - received) <= timeout_;
+  if (latest(torques, n, received)) {
+    std::copy(torques, torques + n, lastTorques_);
+    lastReceived_ = received;
+  } else {  // the receive thread was storing each time: the last command read whole, while fresh
+    std::copy(lastTorques_, lastTorques_ + n, torques);
+    received = lastReceived_;
+  }
+  const bool fresh = received != 0 && 1e-9 * static_cast<double>(steadyNanoseconds() - received) <= timeout_;
   if (fresh) {
     for (int i = 0; i < n; ++i) out_(i) = torques[i];
     if (m.isGravityCompensationOn()) {  // the manipulator adds it: the arm's torque is the command

@@ -31,6 +31,8 @@ class EffortCommandControl : public ServoControl {
   void calculate() override;
   // A checked command of n torques [N m], received now. Real-time safe: yes (one writer).
   void command(const double* torques, int n) noexcept;
+  // The driver let go (an empty command): the arm holds from the next cycle. Real-time safe: yes.
+  void release() noexcept;
   // Whether the last cycle output a command (false: holding). Real-time safe: yes.
   bool isDriving() const noexcept { return driving_.load(std::memory_order_relaxed); }
 
@@ -46,6 +48,8 @@ class EffortCommandControl : public ServoControl {
   std::unique_ptr<ManipulatorData> data_;
   JointVector kp_, kd_, hold_, out_, gravity_;
   bool holding_ = false;
+  double lastTorques_[kMaxJoints] = {};  // the last command read whole, for a cycle whose read collides with a store
+  std::int64_t lastReceived_ = 0;
 };
 
 }  // namespace rp::ros2detail

@@ -66,7 +66,8 @@ struct RemoteManipulator::Impl {
   RemoteManipulatorOptions options;
   std::string nameSpace, object;  // the remote bridge's namespace and the arm's ROS name
   std::string label;              // "NS/OBJECT" for messages
-  dds_entity_t domain = 0, participant = 0;
+  bool leased = false;  // the DDS domain (ros2detail::acquireDomain())
+  dds_entity_t participant = 0;
   dds_entity_t jointStates = 0, state = 0, description = 0, trajectory = 0;
   std::unique_ptr<ManipulatorModel> model;
   int n = 0;
@@ -125,7 +126,7 @@ struct RemoteManipulator::Impl {
   ~Impl() {
     stopThreads();
     if (participant > 0) dds_delete(participant);
-    if (domain > 0) dds_delete(domain);
+    if (leased) ros2detail::releaseDomain(options.domain);
   }
 
   void stopThreads() {
@@ -392,7 +393,8 @@ void RemoteManipulator::connect() {
   d.nameSpace = arm.nameSpace;
   d.object = arm.object;
   d.label = arm.label;
-  d.domain = ros2detail::createDomain(o.domain, Ros2Bridge::cycloneConfig(o.interfaces), "RemoteManipulator", joined(o.interfaces));
+  ros2detail::acquireDomain(o.domain, Ros2Bridge::cycloneConfig(o.interfaces), "RemoteManipulator", joined(o.interfaces));
+  d.leased = true;
   d.participant = dds_create_participant(static_cast<dds_domainid_t>(o.domain), nullptr, nullptr);
   if (d.participant < 0)
     throw std::runtime_error("cannot join DDS domain " + std::to_string(o.domain) + ": " + ddsError(d.participant));

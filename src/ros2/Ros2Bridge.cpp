@@ -127,6 +127,10 @@ struct EffortInput {
   std::atomic<bool> wanted{false};     // a command came: the bridge's cycle connects the control
   std::atomic<bool> connected{false};  // the control drives the arm (the bridge's thread sets it)
   std::atomic<std::uint64_t> accepted{0}, refused{0};
+  // The listener's own: the writer whose commands drive the arm, until it lets go (an empty
+  // command) or sends none for driverHold [ns] (the bridge's effortTimeout).
+  dds_instance_handle_t driver = 0;
+  std::int64_t driverLast = 0, driverHold = 0;
   mutable std::mutex mutex;
   std::string refusal;  // the last refusal, "" if none
 
@@ -149,8 +153,16 @@ struct EffortInput {
       if (count <= 0) return;
       if (info[0].valid_data) {
         const auto& msg = *static_cast<const std_msgs_msg_dds__Float64MultiArray_*>(samples[0]);
+        const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                     std::chrono::steady_clock::now().time_since_epoch()).count();
+        const bool other = driver != 0 && info[0].publication_handle != driver && now - driverLast < driverHold;
         if (!commands->load()) {
           refuse("commands are off (rp.cfg: commands on)");
+        } else if (other) {
+          refuse("another writer drives the arm: one stream of effort commands at a time");
+        } else if (msg.data._length == 0) {  // the driver lets go: the arm holds from its next cycle
+          control->release();
+          driver = 0;
         } else if (msg.data._length != static_cast<uint32_t>(n)) {
           refuse("data: " + std::to_string(msg.data._length) + " efforts, the arm has " + std::to_string(n) + " joints");
         } else {
@@ -161,6 +173,8 @@ struct EffortInput {
             refuse("data[" + std::to_string(bad) + "] is not a finite number");
           } else {
             control->command(msg.data._buffer, n);
+            driver = info[0].publication_handle;
+            driverLast = now;
             ++accepted;
             ++*acceptedTotal;
             if (!connected.load(std::memory_order_relaxed)) wanted = true;
@@ -207,8 +221,7 @@ struct ArmEntry {
 struct Ros2Bridge::Impl {
   Ros2BridgeOptions options;
   std::string nameSpace;  // without leading and trailing '/'
-  dds_entity_t domain = 0;
-  bool ownDomain = false;
+  bool leased = false;  // the DDS domain (ros2detail::acquireDomain())
   dds_entity_t participant = 0;
   std::map<std::string, dds_entity_t> topics;
   dds_entity_t jointStates = 0, tf = 0, tfStatic = 0, description = 0;
@@ -229,7 +242,7 @@ struct Ros2Bridge::Impl {
 
   ~Impl() {
     if (participant > 0) dds_delete(participant);
-    if (ownDomain && domain > 0) dds_delete(domain);
+    if (leased) ros2detail::releaseDomain(options.domain);
   }
 
   dds_entity_t topic(const dds_topic_descriptor_t& desc, const std::string& name) {
@@ -477,8 +490,8 @@ void Ros2Bridge::start() {
   d.nameSpace = ns;
   const auto domainId = static_cast<dds_domainid_t>(d.options.domain);
   const std::string config = cycloneConfig(d.options.interfaces);
-  d.domain = ros2detail::createDomain(d.options.domain, config, "Ros2Bridge", joined(d.options.interfaces));
-  d.ownDomain = d.domain > 0;
+  ros2detail::acquireDomain(d.options.domain, config, "Ros2Bridge", joined(d.options.interfaces));
+  d.leased = true;
   d.participant = dds_create_participant(domainId, nullptr, nullptr);
   if (d.participant < 0)
     throw std::runtime_error("Ros2Bridge: cannot join DDS domain " + std::to_string(d.options.domain) + ": " +
@@ -533,6 +546,7 @@ void Ros2Bridge::Impl::addArm(const RoboticObject* o, Manipulator& m, ArmEntry& 
   e.effort->acceptedTotal = &efforts;
   e.effort->refusedTotal = &effortsRefused;
   e.effort->n = n;
+  e.effort->driverHold = static_cast<std::int64_t>(options.effortTimeout * 1e9);
   e.effort->control = std::make_unique<ros2detail::EffortCommandControl>(bridgeName + "_" + e.rosName + "_effort", options.effortTimeout);
   dds_listener_t* listener = dds_create_listener(e.effort.get());
   dds_lset_data_available(listener, [](dds_entity_t, void* arg) { static_cast<EffortInput*>(arg)->take(); });
@@ -756,7 +770,24 @@ void Ros2Bridge::Impl::takeTrajectories(Manipulator& m, ArmEntry& e) {
 // control (and from the bridge's trajectory generator), unless the arm's program drives it.
 void Ros2Bridge::Impl::connectEffortControl(Manipulator& m, ArmEntry& e) {
   EffortInput& in = *e.effort;
-  if (!in.wanted.exchange(false) || in.connected.load()) return;
+  if (in.connected.load()) {
+    // Still the arm's control? Its program (or an operator's panel) may have set another, or
+    // switched zero-gravity mode on (no servo control runs then): the commands no longer drive it.
+    const std::string why = &m.getServoControl() != in.control.get()
+                                ? "the arm's program set its servo control '" + m.getServoControl().getName() + "'"
+                            : m.isZeroGravityModeOn() ? std::string("the arm is in zero-gravity mode")
+                                                      : std::string();
+    if (why.empty()) return;
+    if (&m.getServoControl() == in.control.get()) m.releaseServoControl(*in.control);
+    in.connected = false;
+    in.refuse(why);
+    return;
+  }
+  if (!in.wanted.exchange(false)) return;
+  if (m.isZeroGravityModeOn()) {
+    in.refuse("the arm is in zero-gravity mode");
+    return;
+  }
   TrajectoryGenerator* driving = m.getTrajectoryGenerator();
   if (driving != nullptr && driving != e.generator.get()) {
     in.refuse("the arm is driven by a trajectory generator of its program ('" + driving->getName() + "')");
@@ -872,10 +903,10 @@ std::string Ros2Bridge::Impl::executeTrajectory(Manipulator& m, ArmEntry& e,
   // The arm: powered, not shutting down, not driven by a program's generator.
   if (ObjectManager::isShutdownRequested()) return "the system is shutting down";
   if (!m.isArmPowerOn()) return "the arm power is off";
-  if (e.effort->connected.load()) {  // driven by effort commands until now: the default control takes over
-    m.releaseServoControl(*e.effort->control);
-    e.effort->connected = false;
-  }
+  // One command stream at a time: a trajectory may take the arm from effort commands only once
+  // they have stopped (the arm holding).
+  if (e.effort->connected.load() && e.effort->control->isDriving())
+    return "the arm is driven by effort commands (" + e.rosName + "/effort_commands)";
   TrajectoryGenerator* driving = m.getTrajectoryGenerator();
   if (driving != nullptr && driving != e.generator.get())
     return "the arm follows the program's trajectory generator '" + driving->getName() + "'";
@@ -910,6 +941,10 @@ std::string Ros2Bridge::Impl::executeTrajectory(Manipulator& m, ArmEntry& e,
     return "points[" + std::to_string(v.point) + "]: " + joint + (v.velocity ? " velocity " : " position ") + number(v.value) +
            (v.velocity ? " exceeds the velocity limit " : " passes the joint limit ") + number(v.limit) + " " + piece +
            " (at " + number(v.time) + " s)";
+  }
+  if (e.effort->connected.load()) {  // held after effort commands: the default control takes over
+    m.releaseServoControl(*e.effort->control);
+    e.effort->connected = false;
   }
   if (driving == nullptr) m.setTrajectoryGenerator(*e.generator);
   const std::size_t size = msg.points._length;

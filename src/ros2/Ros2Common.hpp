@@ -11,6 +11,8 @@
 #include <cctype>
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <chrono>
 #include <cstdint>
 #include <stdexcept>
@@ -90,15 +92,55 @@ inline dds_qos_t* rosQos(bool transientLocal) {
   return qos;
 }
 
-// Creates DDS domain `domain` restricted by `config` (Ros2Bridge::cycloneConfig()) unless this
-// process has it already. Returns the domain entity to delete later, 0 if it existed.
-// `who` and `interfaces` name the caller and the interfaces in the exception.
-inline dds_entity_t createDomain(int domain, const std::string& config, const std::string& who, const std::string& interfaces) {
+// The DDS domains this process created, shared by their users (bridges, remote arms, remote arm
+// boards): deleting a domain deletes every participant in it, so only the last user's release
+// deletes it. A domain some other code created (dds_create_domain directly) is used, never deleted.
+struct DomainRegistry {
+  struct Entry {
+    dds_entity_t entity = 0;  // 0: not ours to delete
+    int users = 0;
+    std::string interfaces;
+  };
+  std::mutex mutex;
+  std::map<int, Entry> domains;
+  // Never destroyed: objects that release their domain may be destroyed at exit, after the
+  // function-local statics (rp's shutdown runs from an exit handler).
+  static DomainRegistry& instance() {
+    static DomainRegistry* r = new DomainRegistry;
+    return *r;
+  }
+};
+
+// Joins DDS domain `domain` restricted by `config` (Ros2Bridge::cycloneConfig()), creating it if
+// this process has not; each call is matched by one releaseDomain() after the caller's participant
+// is deleted. `who` and `interfaces` name the caller and the interfaces in the exception, which
+// also comes when the process uses the domain on other interfaces already.
+inline void acquireDomain(int domain, const std::string& config, const std::string& who, const std::string& interfaces) {
+  DomainRegistry& r = DomainRegistry::instance();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  auto it = r.domains.find(domain);
+  if (it != r.domains.end()) {
+    if (it->second.interfaces != interfaces)
+      throw std::runtime_error(who + ": DDS domain " + std::to_string(domain) + " is used in this process on " +
+                               it->second.interfaces + " already, not on " + interfaces);
+    ++it->second.users;
+    return;
+  }
   const dds_entity_t d = dds_create_domain(static_cast<dds_domainid_t>(domain), config.c_str());
-  if (d >= 0) return d;
-  if (d == DDS_RETCODE_PRECONDITION_NOT_MET) return 0;  // the domain exists in this process already
-  throw std::runtime_error(who + ": DDS domain " + std::to_string(domain) + " cannot start on " + interfaces + ": " +
-                           ddsError(d) + " (see Cyclone DDS's message above)");
+  if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET)  // (not met: created by other code of this process)
+    throw std::runtime_error(who + ": DDS domain " + std::to_string(domain) + " cannot start on " + interfaces + ": " +
+                             ddsError(d) + " (see Cyclone DDS's message above)");
+  r.domains[domain] = {d > 0 ? d : 0, 1, interfaces};
+}
+
+// One user of `domain` lets go (after deleting its participant); the last one deletes it.
+inline void releaseDomain(int domain) {
+  DomainRegistry& r = DomainRegistry::instance();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  auto it = r.domains.find(domain);
+  if (it == r.domains.end() || --it->second.users > 0) return;
+  if (it->second.entity > 0) dds_delete(it->second.entity);
+  r.domains.erase(it);
 }
 
 // A remote arm's address `NS/OBJECT` (`OBJECT` alone without a namespace), split: the namespace

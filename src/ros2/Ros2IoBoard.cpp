@@ -33,6 +33,8 @@ constexpr double kVoltLimit = 10.0;  // the analog outputs' range, +-10 V, as an
 constexpr double kWriterWakeup = 0.01;  // the longest sleep of the writer thread [s]
 constexpr std::uint64_t kRateSamples = 20;  // samples that measure the remote rate at connection
 constexpr double kLongestSampleInterval = 0.005;  // [s] the slowest joint_states a torque loop takes
+constexpr std::int64_t kLongestStampStep = 1000000000;  // [ns] a longer step between stamps is a clock step
+constexpr int kMaxWriteFailures = 10;             // effort commands that fail in a row before it is a fault
 
 std::string seconds(double s) {
   char text[32];
@@ -52,19 +54,23 @@ struct Ros2IoBoard::Impl {
   int n = 0;
   std::vector<std::string> jointNames;  // `<object>_<joint>`, as in joint_states
   std::vector<double> newtonMetresPerVolt;
-  dds_entity_t domain = 0, participant = 0, jointStates = 0, state = 0, effort = 0;
+  bool leased = false;  // the DDS domain (ros2detail::acquireDomain())
+  dds_entity_t participant = 0, jointStates = 0, state = 0, effort = 0;
 
   // Cyclone's receive thread (the listeners) -> the servo thread: a sequence lock. sampleTime is
   // the stored sample's stamp [ns], -1 while one is stored, 0 before the first.
   std::atomic<std::int64_t> sampleTime{0};
   std::array<std::atomic<std::int64_t>, kMaxJoints> counts{};
   std::atomic<std::int64_t> lastReceipt{0};  // steady clock [ns] of the last sample of the arm
-  std::int64_t lastStamp = 0;                // the listener's own: the last stamp stored
+  std::int64_t lastStamp = 0;                // the listener's own: the last sample time stored
+  std::int64_t lastRemoteStamp = 0;          // the listener's own: the last sample's stamp
+  std::int64_t goodStep = 1000000;           // the listener's own: the last plausible stamp step [ns]
   std::atomic<std::int64_t> firstStamp{0}, latestStamp{0};  // of the arm's samples, for the connection's rate check
   std::array<int, kMaxJoints> column{};      // the listener's own: model joint -> joint_states column
   std::atomic<bool> haveState{false}, remotePower{false};
-  // A fault of the remote arm: the text is written once, before the flag is set.
-  std::atomic<bool> remoteFault{false};
+  // A fault of the remote arm, the first one only: 0 none, 1 its text being written (by the thread
+  // that claimed it), 2 written.
+  std::atomic<int> remoteFault{0};
   char faultText[300] = {};
   std::uint64_t refusedBaseline = 0;  // the listener's own: the remote effortsRefused when connected
   bool haveBaseline = false;
@@ -89,7 +95,7 @@ struct Ros2IoBoard::Impl {
     stop = true;
     if (writer.joinable()) writer.join();
     if (participant > 0) dds_delete(participant);  // waits for listeners under way
-    if (domain > 0) dds_delete(domain);
+    if (leased) ros2detail::releaseDomain(options.domain);
   }
 
   dds_entity_t endpoint(const dds_topic_descriptor_t& desc, const std::string& topic, bool isReader, dds_listener_t* listener) {
@@ -103,11 +109,14 @@ struct Ros2IoBoard::Impl {
     return e;
   }
 
+  // Records the first fault (the listeners and the writer thread may find one at once).
   void setFault(const std::string& text) {
-    if (remoteFault.load()) return;
+    int none = 0;
+    if (!remoteFault.compare_exchange_strong(none, 1)) return;
     std::snprintf(faultText, sizeof faultText, "%s", text.c_str());
-    remoteFault.store(true, std::memory_order_release);
+    remoteFault.store(2, std::memory_order_release);
   }
+  bool faulted() const noexcept { return remoteFault.load(std::memory_order_acquire) == 2; }
 
   // Listener of joint_states (Cyclone's receive thread): stores the arm's samples.
   void takeJointStates() {
@@ -126,17 +135,28 @@ struct Ros2IoBoard::Impl {
         column[static_cast<std::size_t>(i)] = c;
       }
       if (ours) {
-        std::int64_t stamp = static_cast<std::int64_t>(js.header.stamp.sec) * 1000000000 + js.header.stamp.nanosec;
-        if (stamp <= lastStamp) stamp = lastStamp + 1;  // every sample a stamp of its own, never 0 or -1
+        // The sample's time: the remote cycles' stamps, so that the velocity is differentiated over
+        // the remote arm's own cycle times (receipt times carry the network's jitter). Where a stamp
+        // does not follow on (the remote wall clock stepped back, or ahead by more than a second),
+        // the step is the last good one: one remote cycle.
+        const std::int64_t remoteStamp = static_cast<std::int64_t>(js.header.stamp.sec) * 1000000000 + js.header.stamp.nanosec;
+        std::int64_t step = remoteStamp - lastRemoteStamp;
+        if (step <= 0 || step > kLongestStampStep)
+          step = goodStep;
+        else
+          goodStep = step;
+        lastRemoteStamp = remoteStamp;
+        const std::int64_t stamp = lastStamp == 0 ? std::max<std::int64_t>(remoteStamp, 1) : lastStamp + step;  // never 0 or -1
         lastStamp = stamp;
         if (firstStamp.load(std::memory_order_relaxed) == 0) firstStamp.store(stamp);
         latestStamp.store(stamp);
+        // A sequence lock without fences (ThreadSanitizer has none): the counts are stored with
+        // release after the -1, and read with acquire before the second look at sampleTime.
         sampleTime.store(-1, std::memory_order_relaxed);
-        std::atomic_thread_fence(std::memory_order_release);
         for (int i = 0; i < n; ++i) {
           const double q = js.position._buffer[static_cast<uint32_t>(column[static_cast<std::size_t>(i)])];
           counts[static_cast<std::size_t>(i)].store(std::isfinite(q) ? std::llround(q * kCountsPerRadian) : 0,
-                                                    std::memory_order_relaxed);
+                                                    std::memory_order_release);
           if (!std::isfinite(q)) setFault("the remote arm " + label + " sent a joint position that is not a number");
         }
         sampleTime.store(stamp, std::memory_order_release);
@@ -189,16 +209,30 @@ struct Ros2IoBoard::Impl {
   void write() {
     std::uint64_t seen = internal::cyclesEnded(), written = 0;
     Command c{};
+    bool on = false;  // the last command written drives the arm
+    int failedInARow = 0;
     while (!stop.load()) {
       seen = internal::waitForCycleEnd(seen, kWriterWakeup);
       if (!commands.readAsOnlyReader(c) || c.sequence == written) continue;
       written = c.sequence;
-      if (!c.power) continue;  // amplifiers off: nothing is commanded (the remote bridge holds the arm)
+      if (!c.power && !on) continue;  // amplifiers off: nothing is commanded (the remote bridge holds the arm)
+      // Amplifiers going off: one empty command, on which the remote bridge holds the arm at once.
+      message.data._length = c.power ? static_cast<uint32_t>(n) : 0;
       std::copy(c.tau, c.tau + n, data.begin());
-      if (dds_write(effort, &message) >= 0)
+      on = c.power;
+      if (dds_write(effort, &message) >= 0) {
         ++sent;
-      else
+        failedInARow = 0;
+      } else {
         ++failures;
+        if (++failedInARow == kMaxWriteFailures)
+          setFault("the effort commands to the remote arm " + label + " cannot be written (" + std::to_string(kMaxWriteFailures) +
+                   " failures in a row)");
+      }
+    }
+    if (on) {  // the board goes (the program ends) while on: let go of the arm
+      message.data._length = 0;
+      (void)dds_write(effort, &message);
     }
   }
 };
@@ -220,8 +254,9 @@ Ros2IoBoard::Ros2IoBoard(const Ros2IoBoardOptions& options, const std::vector<st
   d.newtonMetresPerVolt = newtonMetresPerVolt;
 
   try {
-    d.domain = ros2detail::createDomain(options.domain, Ros2Bridge::cycloneConfig(options.interfaces), "Ros2IoBoard",
-                                        ros2detail::joined(options.interfaces));
+    ros2detail::acquireDomain(options.domain, Ros2Bridge::cycloneConfig(options.interfaces), "Ros2IoBoard",
+                              ros2detail::joined(options.interfaces));
+    d.leased = true;
   } catch (const std::exception& e) {
     throw IoException(e.what());
   }
@@ -262,7 +297,7 @@ Ros2IoBoard::Ros2IoBoard(const Ros2IoBoardOptions& options, const std::vector<st
     throw IoException("Ros2IoBoard: the remote arm " + d.label + "'s joint_states come every " + text +
                       ": an arm driven by torque needs them every servo cycle (rate servo in the remote Ros2Bridge's section)");
   }
-  if (d.remoteFault.load()) throw IoException(std::string("Ros2IoBoard: ") + d.faultText);
+  if (d.faulted()) throw IoException(std::string("Ros2IoBoard: ") + d.faultText);
 
   // The effort message, its buffer made once.
   d.data.assign(static_cast<std::size_t>(d.n), 0.0);
@@ -336,18 +371,17 @@ IoStatus Ros2IoBoard::writeAnalogOutput(int channel, double volts) noexcept {
 IoStatus Ros2IoBoard::readEncoder(int encoder, std::int64_t& counts) noexcept {
   Impl& d = *impl_;
   if (const IoStatus s = checkIndex(encoder, d.n, "encoder"); s != IoStatus::kOk) return s;
-  if (d.remoteFault.load(std::memory_order_acquire)) return error_.set(IoStatus::kDeviceError, "%s", d.faultText);
+  if (d.faulted()) return error_.set(IoStatus::kDeviceError, "%s", d.faultText);
   const double silence = 1e-9 * static_cast<double>(steadyNanoseconds() - d.lastReceipt.load(std::memory_order_acquire));
   if (silence > d.options.timeout)
     return error_.set(IoStatus::kTimeout, "no joint_states from %.100s for %.3f s: the remote arm or its process is gone",
                       d.label.c_str(), silence);
-  counts = d.counts[static_cast<std::size_t>(encoder)].load(std::memory_order_relaxed);
+  counts = d.counts[static_cast<std::size_t>(encoder)].load(std::memory_order_acquire);  // before the next sampleTime load
   return IoStatus::kOk;
 }
 
 std::int64_t Ros2IoBoard::inputSampleTime() const noexcept {
-  // The fence orders the encoder reads before this load (a sequence lock's second check).
-  std::atomic_thread_fence(std::memory_order_acquire);
+  // (readEncoder()'s acquire loads keep the encoder reads before this one: a sequence lock's check.)
   return impl_->sampleTime.load(std::memory_order_acquire);
 }
 

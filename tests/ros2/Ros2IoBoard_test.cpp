@@ -21,6 +21,7 @@
 #include "rp/model/Puma560Model.hpp"
 #include "rp/ros2/Ros2IoBoard.hpp"
 #include "sensor_msgs.h"
+#include "std_msgs.h"
 
 namespace rp::test {
 namespace {
@@ -66,14 +67,18 @@ class Ros2IoBoardTest : public Ros2Fixture {
     return runProgram("timeout -s KILL 120 " + std::string(PICK_AND_PLACE_PATH) + " -config " + config + " -nogui",
                       (dir_ / "run").string());
   }
-  // Waits (at most `seconds`) for a joint_states sample of the remote arm for which `accept` holds.
-  bool waitForJoints(const std::function<bool(const JointVector& q, const JointVector& qd)>& accept, double seconds) {
-    if (jointStates_ == 0) {
-      // The domain on loopback, as ros2_arm's bridge has it (Cyclone's default interface may not be lo).
+  // A reader of the remote arm's `topic`, in this process's domain on loopback as ros2_arm's bridge
+  // has it (Cyclone's default interface may not be lo).
+  dds_entity_t reader(const dds_topic_descriptor_t& desc, const std::string& topic) {
+    if (domain_ == 0) {
       domain_ = dds_create_domain(static_cast<dds_domainid_t>(options_.domain), Ros2Bridge::cycloneConfig({"lo"}).c_str());
       EXPECT_GT(domain_, 0);
-      jointStates_ = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
     }
+    return Ros2Fixture::reader(desc, topic);
+  }
+  // Waits (at most `seconds`) for a joint_states sample of the remote arm for which `accept` holds.
+  bool waitForJoints(const std::function<bool(const JointVector& q, const JointVector& qd)>& accept, double seconds) {
+    if (jointStates_ == 0) jointStates_ = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
     return takeUntil<sensor_msgs_msg_dds__JointState_>(
         jointStates_,
         [&](const sensor_msgs_msg_dds__JointState_& js) {
@@ -195,6 +200,10 @@ TEST_F(Ros2IoBoardTest, ABridgeSlowerThanTheServoRateIsRefused) {
 // while joint states come in and an effort command goes out each cycle.
 TEST_F(Ros2IoBoardTest, TheServoCycleDoesNotAllocate) {
   auto arm = startArm();
+  // The readers first: their domain (on loopback) is then this test's, not the arm's board's,
+  // which would delete it when the arm goes.
+  const dds_entity_t state = reader(std_msgs_msg_dds__String__desc, "puma/state");
+  jointStates_ = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
   RoboticPlatform::setSimulationModeOff();
   configure("[leader]\nclass Puma560\nsimulationMode off\nremote " + ns_ + "/puma\ndomain " + std::to_string(options_.domain) +
             "\nconnectTimeout 30\n");
@@ -209,6 +218,9 @@ TEST_F(Ros2IoBoardTest, TheServoCycleDoesNotAllocate) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     ASSERT_GE(hold.calls.load(), 500);
     EXPECT_EQ(hold.allocations.load(), 0u) << "over " << hold.calls.load() << " cycles";
+    // Meanwhile the cycles' torques drove the remote arm (its bridge says so).
+    EXPECT_TRUE(takeUntil<std_msgs_msg_dds__String_>(
+        state, [](const std_msgs_msg_dds__String_& s) { return contains(s.data, "\"effortDriving\":true"); }, 5));
     EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
     puma.clearTrajectoryGenerator();
   }

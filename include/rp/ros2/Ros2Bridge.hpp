@@ -83,8 +83,11 @@ struct Ros2BridgeStatistics {
 /// then exactly the command (saturated at the torque limits, with the position and velocity limits
 /// checked as always). The first command connects the bridge's effort control to the arm (within a
 /// publishing cycle); when commands stop for `effortTimeout`, the arm holds where it is then, and
-/// a trajectory taken gives it back to its default control. A refused command leaves the arm as
-/// it was and names the field on `<object>/state` (`effort`, `effortsRefused`).
+/// a trajectory taken gives it back to its default control. An empty command lets go at once. One
+/// writer drives an arm at a time (another's commands, and trajectories, are refused while its
+/// commands are fresh); an arm its program takes back (its own servo control, zero-gravity mode)
+/// refuses the commands from then on. A refused command leaves the arm as it was and names the
+/// field on `<object>/state` (`effort`, `effortsRefused`).
 ///
 /// The bridge's own thread samples the arms `rate` times a second from the snapshots their servo
 /// threads publish (as the Scene Viewer does): a servo loop never waits for the bridge or the

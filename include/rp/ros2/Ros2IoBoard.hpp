@@ -47,7 +47,7 @@ struct Ros2IoBoardStatistics {
 /// |---|---|
 /// | encoder k (counts, kCountsPerRadian a radian) | `joint_states` (sensor_msgs/msg/JointState): position of `<object>_<joint k>` |
 /// | analog output k (volts, times the channel's N m per volt) | `<object>/effort_commands` (std_msgs/msg/Float64MultiArray, N m in joint order, as ros2_control's effort forward command controller sends) |
-/// | digital output 0 (amplifiers on) | effort commands are written while it is on; when it goes off none is written, and the remote bridge holds the arm once its `effortTimeout` passes |
+/// | digital output 0 (amplifiers on) | effort commands are written while it is on; when it goes off (and when the board goes while on) one empty command lets go of the arm, which the remote bridge then holds, and none is written after it |
 ///
 /// Samples arrive in Cyclone DDS's receive thread (a listener) and reach the servo loop through a
 /// sequence lock: inputSampleTime() is the remote servo cycle's stamp, so the manipulator
@@ -56,9 +56,9 @@ struct Ros2IoBoardStatistics {
 /// call and does not allocate.
 ///
 /// Faults: a read fails (and the manipulator shuts down, naming the board's message) when no
-/// joint_states came for `timeout`, when the remote arm reports an error or a system shutdown, or
-/// when the remote bridge refused an effort command; switching the amplifiers on fails while the
-/// remote arm's power is off.
+/// joint_states came for `timeout`, when the remote arm reports an error or a system shutdown,
+/// when the remote bridge refused an effort command, or when ten commands in a row could not be
+/// written; switching the amplifiers on fails while the remote arm's power is off.
 class Ros2IoBoard : public IoBoard {
  public:
   /// Encoder counts per joint radian: positions are exact to 1e-9 rad.
