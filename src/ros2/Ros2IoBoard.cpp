@@ -34,7 +34,14 @@ constexpr double kWriterWakeup = 0.01;  // the longest sleep of the writer threa
 constexpr std::uint64_t kRateSamples = 20;  // samples that measure the remote rate at connection
 constexpr double kLongestSampleInterval = 0.005;  // [s] the slowest joint_states a torque loop takes
 constexpr std::int64_t kLongestStampStep = 1000000000;  // [ns] a longer step between stamps is a clock step
+constexpr double kStaleSample = 0.01;  // [s] torques computed from an older sample are not sent
 constexpr int kMaxWriteFailures = 10;             // effort commands that fail in a row before it is a fault
+
+// A bridge's refusal ("refused: why") without its prefix.
+std::string withoutRefusedPrefix(std::string why) {
+  if (why.rfind("refused: ", 0) == 0) why.erase(0, 9);
+  return why;
+}
 
 std::string seconds(double s) {
   char text[32];
@@ -82,6 +89,7 @@ struct Ros2IoBoard::Impl {
     double tau[kMaxJoints];
   };
   Command next{};
+  bool enabled = false;  // digital output 0 as last written (next.power: and the sample fresh)
   TripleBuffer<Command> commands;
   std::thread writer;
   std::atomic<bool> stop{false};
@@ -191,11 +199,7 @@ struct Ros2IoBoard::Impl {
             else if (j.value("shutdown", false))
               setFault("the remote arm " + label + " is shutting down: " + j.value("shutdownReason", std::string()));
             else if (refused > refusedBaseline)
-            {
-              std::string why = j.value("effort", std::string());
-              if (why.rfind("refused: ", 0) == 0) why.erase(0, 9);
-              setFault("the remote arm " + label + " refused the effort commands: " + why);
-            }
+              setFault("the remote arm " + label + " refused the effort commands: " + withoutRefusedPrefix(j.value("effort", std::string())));
           } catch (const std::exception& e) {
             setFault("the remote arm " + label + "'s state: " + e.what());
           }
@@ -343,7 +347,12 @@ IoStatus Ros2IoBoard::writeDigitalOutput(int line, bool value) noexcept {
     status = error_.set(IoStatus::kDeviceError, "the remote arm %.100s's power is off (switch it on in its own process)",
                         d.label.c_str());
   }
-  d.next.power = value;
+  d.enabled = value;
+  // Torques computed from a sample this old are not sent: the remote arm holds (one empty command)
+  // until samples come again, rather than taking torques computed from where it was. (With no
+  // sample for `timeout`, the reads fail and the servo loop shuts down.)
+  const double age = 1e-9 * static_cast<double>(steadyNanoseconds() - d.lastReceipt.load(std::memory_order_acquire));
+  d.next.power = value && age <= kStaleSample;
   ++d.next.sequence;
   d.commands.write(d.next);
   return status;
@@ -351,7 +360,7 @@ IoStatus Ros2IoBoard::writeDigitalOutput(int line, bool value) noexcept {
 
 IoStatus Ros2IoBoard::readDigitalOutput(int line, bool& value) noexcept {
   if (const IoStatus s = checkIndex(line, 1, "digital output"); s != IoStatus::kOk) return s;
-  value = impl_->next.power;
+  value = impl_->enabled;
   return IoStatus::kOk;
 }
 

@@ -6,6 +6,8 @@
 // allocations; the settings' errors. Every program run here has its exit status checked.
 #include <signal.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -227,6 +229,136 @@ TEST_F(Ros2IoBoardTest, TheServoCycleDoesNotAllocate) {
   ASSERT_TRUE(waitForJoints([](const JointVector&, const JointVector& qd) { return qd.cwiseAbs().maxCoeff() < 1e-3; }, 5));
   const std::string armOut = stopArm(*arm);
   EXPECT_FALSE(contains(armOut, "error")) << armOut;
+}
+
+// The board alone against this test as the remote arm (a one-joint arm "arm" published by plain
+// DDS writers): the encoder is the published position; the torque of one volt goes out on
+// arm/effort_commands each cycle; when the samples stop, the torques stop at once (one empty
+// command: the remote bridge holds the arm) and come back with the samples; after `timeout` the
+// reads fail naming the arm; the amplifiers switched off send one empty command.
+TEST_F(Ros2IoBoardTest, TheBoardSendsTorquesOnlyWhileItsSamplesAreFresh) {
+  const dds_entity_t efforts = reader(std_msgs_msg_dds__Float64MultiArray__desc, "arm/effort_commands");
+  auto rawWriter = [&](const dds_topic_descriptor_t& desc, const std::string& topic) {
+    const std::string name = "rt/" + ns_ + "/" + topic;
+    const dds_entity_t t = dds_create_topic(participant_, &desc, name.c_str(), nullptr, nullptr);
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
+    dds_delete_qos(qos);
+    EXPECT_GT(w, 0) << name;
+    return w;
+  };
+  const dds_entity_t joints = rawWriter(sensor_msgs_msg_dds__JointState__desc, "joint_states");
+  const dds_entity_t state = rawWriter(std_msgs_msg_dds__String__desc, "arm/state");
+  std::atomic<bool> publishing{true}, stop{false};
+  std::thread remote([&] {  // the remote arm at 1 kHz: joint1 at 0.5 rad; its state each 50 ms
+    int k = 0;
+    while (!stop.load()) {
+      if (publishing.load()) {
+        sensor_msgs_msg_dds__JointState_ js{};
+        const auto now = std::chrono::system_clock::now().time_since_epoch();
+        js.header.stamp.sec = static_cast<int32_t>(std::chrono::duration_cast<std::chrono::seconds>(now).count());
+        js.header.stamp.nanosec = static_cast<uint32_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count() % 1000000000);
+        js.header.frame_id = const_cast<char*>("");
+        char name[] = "arm_joint1";
+        char* names[] = {name};
+        double q[] = {0.5}, zero[] = {0.0};
+        js.name = {1, 1, names, false};
+        js.position = {1, 1, q, false};
+        js.velocity = {1, 1, zero, false};
+        js.effort = {1, 1, zero, false};
+        dds_write(joints, &js);
+      }
+      if (k++ % 50 == 0) {
+        std_msgs_msg_dds__String_ s{};
+        s.data = const_cast<char*>(R"({"power":true,"errorCode":0,"shutdown":false,"effortsRefused":0})");
+        dds_write(state, &s);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  struct Join {
+    std::atomic<bool>& stop;
+    std::thread& thread;
+    ~Join() {
+      stop = true;
+      thread.join();
+    }
+  } join{stop, remote};
+  // The lengths of the effort commands received since the last call, in order.
+  auto received = [&] {
+    std::vector<uint32_t> lengths;
+    for (;;) {
+      void* samples[1] = {nullptr};
+      dds_sample_info_t info[1];
+      if (dds_take(efforts, samples, info, 1, 1) <= 0) break;
+      const auto& m = *static_cast<const std_msgs_msg_dds__Float64MultiArray_*>(samples[0]);
+      if (info[0].valid_data) {
+        lengths.push_back(m.data._length);
+        if (m.data._length == 1) {
+          EXPECT_DOUBLE_EQ(m.data._buffer[0], 3.0);
+        }
+      }
+      dds_return_loan(efforts, samples, 1);
+    }
+    return lengths;
+  };
+  auto cycles = [](Ros2IoBoard& board, int count, bool on) {  // a servo loop's outputs, 1 ms apart
+    for (int k = 0; k < count; ++k) {
+      board.writeAnalogOutput(0, 1.5);  // 2 N m per volt: 3 N m
+      board.writeDigitalOutput(0, on);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  };
+
+  Ros2IoBoardOptions o;
+  o.remote = ns_ + "/arm";
+  o.domain = options_.domain;
+  o.connectTimeout = 30;
+  Ros2IoBoard board(o, {"joint1"}, {2.0});
+  std::int64_t counts = 0;
+  ASSERT_EQ(board.readEncoder(0, counts), IoStatus::kOk) << board.lastError();
+  EXPECT_EQ(counts, 500000000);  // 0.5 rad at 1e9 counts a radian
+  EXPECT_GT(board.inputSampleTime(), 0);
+
+  cycles(board, 100, true);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  std::vector<uint32_t> got = received();
+  // (Without a servo loop's cycle-end signal the writer wakes each 10 ms, and writes the latest.)
+  EXPECT_GE(std::count(got.begin(), got.end(), 1u), 5) << "torques while on";
+  EXPECT_EQ(std::count(got.begin(), got.end(), 0u), 0);
+
+  publishing = false;  // the samples stop: within 10 ms one empty command, then nothing
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  cycles(board, 40, true);
+  bool on = false;
+  EXPECT_EQ(board.readDigitalOutput(0, on), IoStatus::kOk);
+  EXPECT_TRUE(on) << "the amplifiers stay on as written";
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  got = received();
+  ASSERT_FALSE(got.empty());
+  EXPECT_EQ(got.back(), 0u) << "the last command lets go";
+  EXPECT_EQ(std::count(got.begin(), got.end(), 0u), 1);
+  EXPECT_EQ(board.readEncoder(0, counts), IoStatus::kTimeout) << "no sample for over 0.1 s";
+  EXPECT_TRUE(contains(board.lastError(), "no joint_states from " + ns_ + "/arm")) << board.lastError();
+
+  publishing = true;  // the samples again: torques again
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  cycles(board, 50, true);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  got = received();
+  EXPECT_GE(std::count(got.begin(), got.end(), 1u), 3);
+  EXPECT_EQ(board.readEncoder(0, counts), IoStatus::kOk) << board.lastError();
+
+  cycles(board, 20, false);  // the amplifiers off: one empty command, then nothing
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  got = received();
+  ASSERT_FALSE(got.empty());
+  EXPECT_EQ(got.back(), 0u);
+  EXPECT_EQ(std::count(got.begin(), got.end(), 0u), 1);
+  const Ros2IoBoardStatistics st = board.getStatistics();
+  EXPECT_GT(st.samples, 100u);
+  EXPECT_EQ(st.writeFailures, 0u);
 }
 
 TEST_F(Ros2IoBoardTest, SettingsErrorsNameTheFileAndLine) {

@@ -47,7 +47,7 @@ struct Ros2IoBoardStatistics {
 /// |---|---|
 /// | encoder k (counts, kCountsPerRadian a radian) | `joint_states` (sensor_msgs/msg/JointState): position of `<object>_<joint k>` |
 /// | analog output k (volts, times the channel's N m per volt) | `<object>/effort_commands` (std_msgs/msg/Float64MultiArray, N m in joint order, as ros2_control's effort forward command controller sends) |
-/// | digital output 0 (amplifiers on) | effort commands are written while it is on; when it goes off (and when the board goes while on) one empty command lets go of the arm, which the remote bridge then holds, and none is written after it |
+/// | digital output 0 (amplifiers on) | effort commands are written while it is on and the last sample is at most 10 ms old; when it goes off, or the samples go stale (and when the board goes while on), one empty command lets go of the arm, which the remote bridge then holds, and none is written after it until both hold again |
 ///
 /// Samples arrive in Cyclone DDS's receive thread (a listener) and reach the servo loop through a
 /// sequence lock: inputSampleTime() is the remote servo cycle's stamp, so the manipulator
@@ -98,9 +98,10 @@ class Ros2IoBoard : public IoBoard {
   int numEncoders() const noexcept override;
   /// No digital inputs: `kInvalidLine`. Real-time safe: yes.
   IoStatus readDigitalInput(int line, bool& value) noexcept override;
-  /// Line 0: on writes this cycle's effort commands (and those of the cycles that follow), off
-  /// writes none. Hands the cycle's outputs to the writer thread. Fails while the remote arm's
-  /// power is off. Real-time safe: yes.
+  /// Line 0: on writes this cycle's effort commands (and those of the cycles that follow) while
+  /// the last sample is at most 10 ms old, off writes none (one empty command on the way off).
+  /// Hands the cycle's outputs to the writer thread. Fails while the remote arm's power is off.
+  /// Real-time safe: yes.
   IoStatus writeDigitalOutput(int line, bool value) noexcept override;
   /// Line 0 as last written. Real-time safe: yes.
   IoStatus readDigitalOutput(int line, bool& value) noexcept override;
