@@ -1,5 +1,7 @@
 #include "EffortCommandControl.hpp"
 
+#include "Ros2Common.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
@@ -10,11 +12,6 @@
 
 namespace rp::ros2detail {
 
-namespace {
-std::int64_t steadyNanoseconds() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-}  // namespace
 
 EffortCommandControl::EffortCommandControl(const std::string& name, double timeout) : ServoControl(name), timeout_(timeout) {}
 

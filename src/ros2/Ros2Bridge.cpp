@@ -146,43 +146,34 @@ struct EffortInput {
   }
   // The listener: every command received.
   void take() {
-    for (;;) {
-      void* samples[1] = {nullptr};
-      dds_sample_info_t info[1];
-      const dds_return_t count = dds_take(reader, samples, info, 1, 1);
-      if (count <= 0) return;
-      if (info[0].valid_data) {
-        const auto& msg = *static_cast<const std_msgs_msg_dds__Float64MultiArray_*>(samples[0]);
-        const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                     std::chrono::steady_clock::now().time_since_epoch()).count();
-        const bool other = driver != 0 && info[0].publication_handle != driver && now - driverLast < driverHold;
-        if (!commands->load()) {
-          refuse("commands are off (rp.cfg: commands on)");
-        } else if (other) {
-          refuse("another writer drives the arm: one stream of effort commands at a time");
-        } else if (msg.data._length == 0) {  // the driver lets go: the arm holds from its next cycle
-          control->release();
-          driver = 0;
-        } else if (msg.data._length != static_cast<uint32_t>(n)) {
-          refuse("data: " + std::to_string(msg.data._length) + " efforts, the arm has " + std::to_string(n) + " joints");
+    ros2detail::takeEach<std_msgs_msg_dds__Float64MultiArray_>(reader, [&](const std_msgs_msg_dds__Float64MultiArray_& msg, const dds_sample_info_t& info) {
+      const std::int64_t now = ros2detail::steadyNanoseconds();
+      const bool other = driver != 0 && info.publication_handle != driver && now - driverLast < driverHold;
+      if (!commands->load()) {
+        refuse("commands are off (rp.cfg: commands on)");
+      } else if (other) {
+        refuse("another writer drives the arm: one stream of effort commands at a time");
+      } else if (msg.data._length == 0) {  // the driver lets go: the arm holds from its next cycle
+        control->release();
+        driver = 0;
+      } else if (msg.data._length != static_cast<uint32_t>(n)) {
+        refuse("data: " + std::to_string(msg.data._length) + " efforts, the arm has " + std::to_string(n) + " joints");
+      } else {
+        int bad = -1;
+        for (int i = 0; i < n && bad < 0; ++i)
+          if (!std::isfinite(msg.data._buffer[i])) bad = i;
+        if (bad >= 0) {
+          refuse("data[" + std::to_string(bad) + "] is not a finite number");
         } else {
-          int bad = -1;
-          for (int i = 0; i < n && bad < 0; ++i)
-            if (!std::isfinite(msg.data._buffer[i])) bad = i;
-          if (bad >= 0) {
-            refuse("data[" + std::to_string(bad) + "] is not a finite number");
-          } else {
-            control->command(msg.data._buffer, n);
-            driver = info[0].publication_handle;
-            driverLast = now;
-            ++accepted;
-            ++*acceptedTotal;
-            if (!connected.load(std::memory_order_relaxed)) wanted = true;
-          }
+          control->command(msg.data._buffer, n);
+          driver = info.publication_handle;
+          driverLast = now;
+          ++accepted;
+          ++*acceptedTotal;
+          if (!connected.load(std::memory_order_relaxed)) wanted = true;
         }
       }
-      dds_return_loan(reader, samples, count);
-    }
+    });
   }
 };
 

@@ -178,6 +178,30 @@ inline void addInterfacesSetting(SettingSchema& schema) {
   schema.addWords("interfaces", 1, 16, "network interfaces (names or IPv4 addresses) DDS may use; any: Cyclone DDS's choice");
 }
 
+// The steady clock [ns]: receipt times and ages (no system call: vDSO).
+inline std::int64_t steadyNanoseconds() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Takes every sample `reader` holds, one at a time, and calls `use(sample, info)` for each one with
+// valid data; each loan is returned however `use` ends. For listeners and reader threads.
+template <class T, class Use>
+void takeEach(dds_entity_t reader, Use&& use) {
+  for (;;) {
+    void* loan[1] = {nullptr};
+    dds_sample_info_t info[1];
+    const dds_return_t count = dds_take(reader, loan, info, 1, 1);
+    if (count <= 0) return;
+    struct Return {
+      dds_entity_t reader;
+      void** loan;
+      dds_return_t count;
+      ~Return() { dds_return_loan(reader, loan, count); }
+    } giveBack{reader, loan, count};
+    if (info[0].valid_data) use(*static_cast<const T*>(loan[0]), info[0]);
+  }
+}
+
 // The wall clock, the source of ROS time [ns since the epoch].
 inline std::int64_t wallNanoseconds() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())

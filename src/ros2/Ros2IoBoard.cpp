@@ -28,6 +28,7 @@ namespace rp {
 namespace {
 
 using ros2detail::ddsError;
+using ros2detail::steadyNanoseconds;
 
 constexpr double kVoltLimit = 10.0;  // the analog outputs' range, +-10 V, as an amplifier's input
 constexpr double kWriterWakeup = 0.01;  // the longest sleep of the writer thread [s]
@@ -47,10 +48,6 @@ std::string seconds(double s) {
   char text[32];
   std::snprintf(text, sizeof text, "%g s", s);
   return text;
-}
-
-std::int64_t steadyNanoseconds() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 }  // namespace
@@ -128,13 +125,8 @@ struct Ros2IoBoard::Impl {
 
   // Listener of joint_states (Cyclone's receive thread): stores the arm's samples.
   void takeJointStates() {
-    for (;;) {
-      void* loan[1] = {nullptr};
-      dds_sample_info_t info[1];
-      const dds_return_t count = dds_take(jointStates, loan, info, 1, 1);
-      if (count <= 0) return;
-      const auto& js = *static_cast<const sensor_msgs_msg_dds__JointState_*>(loan[0]);
-      bool ours = info[0].valid_data && js.position._length == js.name._length;
+    ros2detail::takeEach<sensor_msgs_msg_dds__JointState_>(jointStates, [&](const sensor_msgs_msg_dds__JointState_& js, const dds_sample_info_t&) {
+      bool ours = js.position._length == js.name._length;
       for (int i = 0; i < n && ours; ++i) {  // each of the arm's joints named in it
         int c = -1;
         for (uint32_t k = 0; k < js.name._length && c < 0; ++k)
@@ -171,42 +163,34 @@ struct Ros2IoBoard::Impl {
         lastReceipt.store(steadyNanoseconds(), std::memory_order_release);
         ++samples;
       }
-      dds_return_loan(jointStates, loan, count);
-    }
+    });
   }
 
   // Listener of `<object>/state` (Cyclone's receive thread): the remote arm's power and faults.
   void takeStates() {
-    for (;;) {
-      void* loan[1] = {nullptr};
-      dds_sample_info_t info[1];
-      const dds_return_t count = dds_take(state, loan, info, 1, 1);
-      if (count <= 0) return;
-      const auto& s = *static_cast<const std_msgs_msg_dds__String_*>(loan[0]);
-      if (info[0].valid_data && s.data != nullptr) {
-        const nlohmann::json j = nlohmann::json::parse(s.data, nullptr, false);
-        if (j.is_object()) {
-          try {
-            const auto refused = j.value("effortsRefused", std::uint64_t{0});
-            if (!haveBaseline) {
-              refusedBaseline = refused;
-              haveBaseline = true;
-            }
-            remotePower.store(j.value("power", false));
-            haveState.store(true, std::memory_order_release);
-            if (j.value("errorCode", 0) != 0)
-              setFault("the remote arm " + label + " reports an error: " + j.value("error", std::string()));
-            else if (j.value("shutdown", false))
-              setFault("the remote arm " + label + " is shutting down: " + j.value("shutdownReason", std::string()));
-            else if (refused > refusedBaseline)
-              setFault("the remote arm " + label + " refused the effort commands: " + withoutRefusedPrefix(j.value("effort", std::string())));
-          } catch (const std::exception& e) {
-            setFault("the remote arm " + label + "'s state: " + e.what());
+    ros2detail::takeEach<std_msgs_msg_dds__String_>(state, [&](const std_msgs_msg_dds__String_& s, const dds_sample_info_t&) {
+      if (s.data == nullptr) return;
+      const nlohmann::json j = nlohmann::json::parse(s.data, nullptr, false);
+      if (j.is_object()) {
+        try {
+          const auto refused = j.value("effortsRefused", std::uint64_t{0});
+          if (!haveBaseline) {
+            refusedBaseline = refused;
+            haveBaseline = true;
           }
+          remotePower.store(j.value("power", false));
+          haveState.store(true, std::memory_order_release);
+          if (j.value("errorCode", 0) != 0)
+            setFault("the remote arm " + label + " reports an error: " + j.value("error", std::string()));
+          else if (j.value("shutdown", false))
+            setFault("the remote arm " + label + " is shutting down: " + j.value("shutdownReason", std::string()));
+          else if (refused > refusedBaseline)
+            setFault("the remote arm " + label + " refused the effort commands: " + withoutRefusedPrefix(j.value("effort", std::string())));
+        } catch (const std::exception& e) {
+          setFault("the remote arm " + label + "'s state: " + e.what());
         }
       }
-      dds_return_loan(state, loan, count);
-    }
+    });
   }
 
   // The writer thread: after each cycle of a loop, the outputs it handed over, if new and on.
