@@ -33,6 +33,12 @@
 // in /tmp as the section of class Puma560): RK4 takes four forward-dynamics evaluations per step,
 // semi-implicit Euler one.
 //
+// --mode cost (not part of `both`): the CPU per arm-cycle as the count grows, without wake-ups or
+// deadlines: the arms on the simulated clock (one executor stepping them as fast as it can), each
+// count from --start doubling to --max (default 512) for --seconds, one line each
+//   cost N  cpu_us_per_arm_cycle C
+// What grows with N here is the memory the arms' cycles touch outgrowing the caches and the TLB.
+//
 // Usage: arms_per_core [--mode M] [--integrator I] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
 #include <sched.h>
 #include <unistd.h>
@@ -162,6 +168,7 @@ Trial attempt(int n, double seconds, int tries) {
 
 int main(int argc, char** argv) {
   int cpu = 1, start = 16, max = 4096, resolution = 4, tries = 3;
+  bool maxGiven = false;
   double seconds = 5;
   std::string mode = "both", integrator = "rk4";
   for (int i = 1; i < argc; ++i) {
@@ -175,8 +182,8 @@ int main(int argc, char** argv) {
     };
     if (a == "--mode") {
       mode = value();
-      if (mode != "shared" && mode != "own" && mode != "both" && mode != "spread") {
-        std::fprintf(stderr, "arms_per_core: --mode must be shared, own, both or spread\n");
+      if (mode != "shared" && mode != "own" && mode != "both" && mode != "spread" && mode != "cost") {
+        std::fprintf(stderr, "arms_per_core: --mode must be shared, own, both, spread or cost\n");
         return 2;
       }
     } else if (a == "--integrator") {
@@ -193,13 +200,14 @@ int main(int argc, char** argv) {
       start = std::atoi(value());
     } else if (a == "--max") {
       max = std::atoi(value());
+      maxGiven = true;
     } else if (a == "--tries") {
       tries = std::max(1, std::atoi(value()));
     } else if (a == "--resolution") {
       resolution = std::max(1, std::atoi(value()));
     } else {
       std::fprintf(stderr,
-                   "usage: arms_per_core [--mode shared|own|both|spread] [--integrator rk4|euler] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
+                   "usage: arms_per_core [--mode shared|own|both|spread|cost] [--integrator rk4|euler] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
       return 2;
     }
   }
@@ -228,6 +236,19 @@ int main(int argc, char** argv) {
   RoboticPlatform::setConfigurationFileName(config);
   RoboticPlatform::loadConfiguration();
 
+  if (mode == "cost") {
+    RoboticPlatform::useSimulatedClock();
+    if (!maxGiven) max = 512;
+    std::printf("mode cost: simulated Puma 560 arms (integrator %s) on the simulated clock on CPU %d, %.1f s each\n",
+                integrator.c_str(), cpu, seconds);
+    for (int n = start; n <= max; n *= 2) {
+      const Trial t = run(n, seconds);
+      std::printf("cost %4d  cpu_us_per_arm_cycle %6.2f%s\n", n, t.cpuPerCycle, t.errors ? "  (arm errors)" : "");
+      std::fflush(stdout);
+    }
+    std::remove(config.c_str());
+    return 0;
+  }
   std::vector<std::string> modes;
   if (mode == "both" || mode == "shared") modes.push_back("shared");
   if (mode == "both" || mode == "own") modes.push_back("own");

@@ -152,6 +152,27 @@ void servoCycle(benchmark::State& s, SimulationIntegrator integrator) {
 void ServoCycle_rpEuler(benchmark::State& s) { servoCycle(s, SimulationIntegrator::Euler); }
 void ServoCycle_rpRK4(benchmark::State& s) { servoCycle(s, SimulationIntegrator::RK4); }
 
+// One servo cycle of an arm in motion, as bench/arms_per_core's arms move: the target swings
+// 0.1 rad at 0.5 Hz on joints 1-3 about the start, the other joints held, so some joints slide
+// and others stick (the friction solve's harder case; the cycles above end at rest).
+void servoCycleMoving(benchmark::State& s, SimulationIntegrator integrator) {
+  Arm& a = arm(s);
+  a.sim->setIntegrator(integrator);
+  const JointVector start = a.target;
+  a.sim->setState(start, JointVector(a.model->getNumberOfJoints()));
+  long k = 0;
+  for (auto _ : s) {
+    const double swing = 0.1 * std::sin(2 * 3.14159265358979 * 0.5 * 1e-3 * static_cast<double>(k++));
+    for (int i = 0; i < 3; ++i) a.target(i) = start(i) + swing;
+    a.control(a.sim->getPosition(), a.sim->getVelocity());
+    a.sim->step(a.tau, 1e-3);
+    benchmark::DoNotOptimize(a.sim->getPosition().data());
+  }
+  a.target = start;
+}
+void ServoCycle_rpEulerMoving(benchmark::State& s) { servoCycleMoving(s, SimulationIntegrator::Euler); }
+void ServoCycle_rpRK4Moving(benchmark::State& s) { servoCycleMoving(s, SimulationIntegrator::RK4); }
+
 // The simulation step alone (no control law), each integrator, next to Part_MuJoCoStep.
 void stepOnly(benchmark::State& s, SimulationIntegrator integrator) {
   Arm& a = arm(s);
@@ -241,6 +262,8 @@ void Part_MuJoCoStep(benchmark::State& s) {
 BENCHMARK(ServoCycle_rp)->Arg(6)->Arg(7);
 BENCHMARK(ServoCycle_rpEuler)->Arg(6)->Arg(7);
 BENCHMARK(ServoCycle_rpRK4)->Arg(6)->Arg(7);
+BENCHMARK(ServoCycle_rpEulerMoving)->Arg(6)->Arg(7);
+BENCHMARK(ServoCycle_rpRK4Moving)->Arg(6)->Arg(7);
 BENCHMARK(Part_rpStepEuler)->Arg(6)->Arg(7);
 BENCHMARK(Part_rpStepRK4)->Arg(6)->Arg(7);
 BENCHMARK(ServoCycle_MuJoCo)->Arg(6)->Arg(7);

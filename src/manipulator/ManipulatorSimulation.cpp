@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -144,6 +145,54 @@ void choleskySolve(const JointMatrix& A, const JointVector& b, JointMatrix& L, J
   }
 }
 
+// The contact mode of the velocities v of solveFriction(): two bits per joint, sliding forward,
+// sliding backward (neither: at rest).
+std::uint64_t contactMode(const JointVector& v) noexcept {
+  std::uint64_t mode = 0;
+  for (int i = 0; i < v.size(); ++i)
+    mode |= (v(i) > 0 ? std::uint64_t{1} : v(i) < 0 ? std::uint64_t{2} : std::uint64_t{0}) << (2 * i);
+  return mode;
+}
+
+// The friction problem of ManipulatorSimulation::solveFriction() (A, rhs, friction bounds upper
+// and lower) solved exactly in the contact mode of v, which it replaces if that solution is the
+// minimiser. L and x are scratch. Real-time safe: yes.
+bool solveContactMode(const JointMatrix& A, const JointVector& rhs, const JointVector& upper,
+                      const JointVector& lower, JointMatrix& L, JointVector& x, JointVector& v) noexcept {
+  // In the mode of v, the sliding joints s feel their friction c_s (upper forward, -lower
+  // backward) and the others are at rest, so A_ss v_s = rhs_s - c_s. That v is the minimiser if
+  // it keeps the mode (each v_s strictly in its direction) and the torque that holds each joint
+  // at rest, rhs_i - (A v)_i, is within its friction [-lower_i, upper_i]: the optimality
+  // conditions of the (strictly convex) problem. Otherwise nothing changes.
+  const int n = static_cast<int>(v.size());
+  std::array<int, kMaxJoints> s{};
+  int m = 0;
+  for (int i = 0; i < n; ++i)
+    if (v(i) != 0) s[static_cast<std::size_t>(m++)] = i;
+  JointMatrix As(m, m);  // A_ss (fixed capacity: no allocation)
+  JointVector bs(m);     // rhs_s - c_s
+  for (int a = 0; a < m; ++a) {
+    const int i = s[static_cast<std::size_t>(a)];
+    bs(a) = rhs(i) - (v(i) > 0 ? upper(i) : -lower(i));
+    for (int c = 0; c < m; ++c) As(a, c) = A(i, s[static_cast<std::size_t>(c)]);
+  }
+  choleskySolve(As, bs, L, x);  // A_ss is positive definite (A is)
+  for (int a = 0; a < m; ++a)
+    if (!(x(a) * v(s[static_cast<std::size_t>(a)]) > 0)) return false;  // (a NaN fails too)
+  for (int i = 0, a = 0; i < n; ++i) {
+    if (a < m && s[static_cast<std::size_t>(a)] == i) {
+      ++a;
+      continue;
+    }
+    double hold = rhs(i);
+    for (int b = 0; b < m; ++b) hold -= A(i, s[static_cast<std::size_t>(b)]) * x(b);
+    if (!(hold <= upper(i) && hold >= -lower(i))) return false;
+  }
+  v.setZero();
+  for (int a = 0; a < m; ++a) v(s[static_cast<std::size_t>(a)]) = x(a);
+  return true;
+}
+
 }  // namespace
 
 // The unit payload models by centre, kept for the simulation's life (the stepping thread may use
@@ -253,7 +302,7 @@ void ManipulatorSimulation::setState(const JointVector& q, const JointVector& qd
   q_ = q;
   qd_ = qd;
   qdd_.setZero();
-  for (int k = 0; k <= kMaxSensorDelay; ++k) {
+  for (int k = 0; k <= delay_; ++k) {
     head_ = k;
     recordReading();
   }
@@ -292,13 +341,13 @@ void ManipulatorSimulation::setEncoderOffset(const JointVector& offset) {
 }
 
 void ManipulatorSimulation::recordReading() {
-  const auto k = static_cast<std::size_t>(head_);
-  readPosition_[k] = q_ + encoderOffset_;
-  readVelocity_[k] = qd_;
+  Reading& r = readings_[static_cast<std::size_t>(head_)];
+  r.position = q_ + encoderOffset_;
+  r.velocity = qd_;
   // An encoder counts whole increments: the reading is the count below the position.
   for (int i = 0; i < countsPerRadian_.size(); ++i)
     if (std::isfinite(countsPerRadian_(i)))
-      readPosition_[k](i) = std::floor(readPosition_[k](i) * countsPerRadian_(i)) / countsPerRadian_(i);
+      r.position(i) = std::floor(r.position(i) * countsPerRadian_(i)) / countsPerRadian_(i);
 }
 
 void ManipulatorSimulation::setBrakeTorque(const JointVector& torque) {
@@ -343,7 +392,7 @@ void ManipulatorSimulation::step(const JointVector& tau, double dt) {
     const double h = dt / substeps;
     for (int s = 0; s < substeps; ++s) eulerStep(h);
   }
-  head_ = (head_ + 1) % (kMaxSensorDelay + 1);
+  head_ = head_ == delay_ ? 0 : head_ + 1;
   recordReading();
 }
 
@@ -479,6 +528,7 @@ void ManipulatorSimulation::solveFriction(double h) {
   }
   residual_.noalias() = A_ * qd_;
   residual_ -= rhs_;
+  std::uint64_t lastMode = contactMode(qd_), triedMode = ~std::uint64_t{0};
   for (int sweep = 0; sweep < kMaxFrictionSweeps; ++sweep) {
     double change = 0;
     for (int i = 0; i < n; ++i) {
@@ -500,8 +550,19 @@ void ManipulatorSimulation::solveFriction(double h) {
       change = std::max(change, std::abs(d));
     }
     if (change <= kFrictionTolerance) break;
+    // The contact mode the sweep has reached (which joints stick, which way the others slide) is
+    // usually the minimiser's after one sweep: that mode's exact solution, if it is optimal, ends
+    // the sweeps. Later, a mode is tried once a sweep leaves it unchanged, and never again after
+    // failing (its solution depends on the mode alone).
+    const std::uint64_t mode = contactMode(qd_);
+    if ((sweep == 0 || mode == lastMode) && mode != triedMode) {
+      if (solveContactMode(A_, rhs_, upper_, lower_, L_, kq_, qd_)) break;
+      triedMode = mode;
+    }
+    lastMode = mode;
   }
 }
+
 
 void ManipulatorSimulation::declareSettings(SettingSchema& schema) {
   schema.addChoice("integrator", {"euler", "rk4"}, "integrator of the simulated arm (semi-implicit Euler or RK4)");

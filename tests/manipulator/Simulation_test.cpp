@@ -179,6 +179,113 @@ struct FrictionReference {
   }
 };
 
+// One semi-implicit Euler step with Coulomb friction is a convex problem in the new velocity v:
+// minimise 1/2 v^T A v - r^T v + h sum_i f_i(v_i), with A = M(q) + h diag(b) (b the viscous
+// friction), r = M(q) qd + h (tau - g(q) - C(q, qd) qd) and f_i the joint's Coulomb dissipation.
+// Its minimiser is the one contact mode of the 3^n (each joint stuck, sliding up or down) whose
+// linear system gives velocities in the mode's directions and holding torques within the stuck
+// joints' friction. From states slow enough that friction stops some joints within the step and
+// not others, the simulation's step must land on that solution, found here by enumeration.
+TEST(SimulationFriction, AnEulerStepIsTheExactSolutionOfTheFrictionLaw) {
+  std::mt19937 rng(11);
+  int arms = 0;
+  for (const auto& model : allArms()) {
+    const int n = model->getNumberOfJoints();
+    bool coulomb = false;
+    for (int i = 0; i < n; ++i) coulomb = coulomb || coulombPos(model->getLink(i)) > 0 || coulombNeg(model->getLink(i)) > 0;
+    if (!coulomb) continue;
+    ++arms;
+    ManipulatorData data(*model);
+    DynamicsOptions options;
+    options.motorInertia = true;
+    const double h = 1e-3;
+    int mixed = 0, cases = 0;
+    double worst = 0;
+    for (int trial = 0; trial < 150; ++trial) {
+      JointVector q(n), qd(n), tau(n), b(n), up(n), down(n);
+      for (int i = 0; i < n; ++i) {
+        std::uniform_real_distribution<double> in(model->getPositionMin()(i) + 0.1, model->getPositionMax()(i) - 0.1);
+        q(i) = in(rng);
+      }
+      const JointMatrix M = massMatrix(*model, data, q, true);
+      JointVector g(n);
+      gravityTorque(*model, data, q, g);
+      for (int i = 0; i < n; ++i) {
+        const LinkParameters& l = model->getLink(i);
+        b(i) = l.viscousFriction * l.gearRatio * l.gearRatio;
+        up(i) = coulombPos(l);
+        down(i) = coulombNeg(l);
+        // About what friction takes from the joint in one step, either way, and a torque about
+        // the size of its friction beyond gravity: some joints stop, others slide.
+        const double dv = h * std::max(up(i), down(i)) / M(i, i);
+        qd(i) = std::uniform_real_distribution<double>(-2.0, 2.0)(rng) * dv;
+        tau(i) = g(i) + std::uniform_real_distribution<double>(-1.5, 1.5)(rng) * std::max(up(i), down(i));
+        tau(i) = std::clamp(tau(i), -model->getTorqueLimit()(i), model->getTorqueLimit()(i));  // as the plant applies it
+      }
+      const JointVector bias = inverseDynamics(*model, data, q, qd, JointVector::Zero(n), options);
+      Eigen::MatrixXd A = Eigen::MatrixXd(M.topLeftCorner(n, n));
+      for (int i = 0; i < n; ++i) A(i, i) += h * b(i);
+      const Eigen::VectorXd r = Eigen::MatrixXd(M.topLeftCorner(n, n)) * Eigen::VectorXd(qd) + h * Eigen::VectorXd(tau - bias);
+      // Enumerate the modes.
+      std::vector<Eigen::VectorXd> solutions;
+      int total = 1;
+      for (int i = 0; i < n; ++i) total *= 3;
+      for (int code = 0; code < total; ++code) {
+        std::vector<int> mode(static_cast<std::size_t>(n)), slide;
+        for (int i = 0, c = code; i < n; ++i, c /= 3) {
+          mode[static_cast<std::size_t>(i)] = c % 3 - 1;
+          if (c % 3 != 1) slide.push_back(i);
+        }
+        const auto m = static_cast<int>(slide.size());
+        Eigen::MatrixXd As(m, m);
+        Eigen::VectorXd rs(m);
+        for (int a = 0; a < m; ++a) {
+          const int i = slide[static_cast<std::size_t>(a)];
+          rs(a) = r(i) - h * (mode[static_cast<std::size_t>(i)] > 0 ? up(i) : -down(i));
+          for (int c = 0; c < m; ++c) As(a, c) = A(i, slide[static_cast<std::size_t>(c)]);
+        }
+        Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+        if (m > 0) {
+          const Eigen::VectorXd vs = As.llt().solve(rs);
+          for (int a = 0; a < m; ++a) v(slide[static_cast<std::size_t>(a)]) = vs(a);
+        }
+        const Eigen::VectorXd hold = r - A * v;  // what friction must supply at each joint
+        bool ok = true;
+        for (int i = 0; i < n; ++i) {
+          const int s = mode[static_cast<std::size_t>(i)];
+          if (s != 0 && !(s * v(i) > 0)) ok = false;
+          if (s == 0 && !(hold(i) <= h * up(i) && hold(i) >= -h * down(i))) ok = false;
+        }
+        if (ok) solutions.push_back(v);
+      }
+      ASSERT_EQ(solutions.size(), 1u) << model->getName() << " trial " << trial;  // strictly convex
+      const Eigen::VectorXd& expected = solutions.front();
+      int stuck = 0;
+      for (int i = 0; i < n; ++i) stuck += expected(i) == 0;
+      mixed += stuck > 0 && stuck < n;
+      ++cases;
+
+      ManipulatorSimulation sim(*model);
+      sim.setIntegrator(SimulationIntegrator::Euler);
+      sim.setState(q, qd);
+      sim.step(tau, h);
+      for (int i = 0; i < n; ++i) {
+        const double error = std::abs(sim.getTrueVelocity()(i) - expected(i));
+        worst = std::max(worst, error);
+        EXPECT_LT(error, 1e-10) << model->getName() << " trial " << trial << " joint " << i + 1;
+        // A joint the law holds is exactly at rest.
+        if (expected(i) == 0) {
+          EXPECT_EQ(sim.getTrueVelocity()(i), 0.0) << model->getName() << " trial " << trial;
+        }
+      }
+    }
+    std::printf("  %s: %d of %d steps with joints both stuck and sliding; worst velocity difference %.3g rad/s\n",
+                model->getName().c_str(), mixed, cases, worst);
+    EXPECT_GT(mixed, cases / 4) << "the states must mix stick and slip to test the law";
+  }
+  EXPECT_GE(arms, 1);
+}
+
 // The Puma's shoulder falls freely (no torque) with the upper arm starting horizontal: its
 // friction, and the torques that hold the joints that stick, act through the full mass matrix.
 TEST(SimulationFriction, PumaShoulderFreeFallMatchesTheReference) {

@@ -46,7 +46,11 @@ struct PlantDeviations {
 /// brakes are on). Its optimality conditions are stick and slip exactly: a sliding joint feels
 /// \f$F^\pm_i\f$ against its motion, a joint at rest stays there while the torque holding it
 /// (which reaches the other joints through \f$M\f$) is within \f$[-F^+_i, F^-_i]\f$. It is solved
-/// by exact coordinate descent (a convex problem; bounded iterations, no allocation).
+/// by exact coordinate descent (a convex problem; bounded iterations, no allocation), each sweep
+/// followed by the exact solution of the contact mode it reached (which joints stick, which way the
+/// others slide: a linear system) when that mode is new after the first sweep or unchanged by a
+/// later one; the first such solution that satisfies the optimality conditions ends the sweeps
+/// (usually after one).
 ///
 /// Torques are saturated at the model's torque limits. Joints meet their limits as stiff
 /// spring-damper stops (setStopStiffness()), critically damped for the inertia of the joint at the
@@ -107,10 +111,10 @@ class ManipulatorSimulation {
   /// Joint positions as the simulated encoders read them (n x 1) [rad]: the plant's, quantised to
   /// the encoder resolution and as old as the sensor delay (see setSensor()); the true positions
   /// without them. Real-time safe: yes.
-  const JointVector& getPosition() const { return readPosition_[readIndex()]; }
+  const JointVector& getPosition() const { return readings_[readIndex()].position; }
   /// Joint velocities as read (n x 1) [rad/s]: the plant's, as old as the sensor delay (not
   /// quantised). Real-time safe: yes.
-  const JointVector& getVelocity() const { return readVelocity_[readIndex()]; }
+  const JointVector& getVelocity() const { return readings_[readIndex()].velocity; }
   /// The plant's joint positions (n x 1) [rad]. Real-time safe: yes.
   const JointVector& getTruePosition() const { return q_; }
   /// The plant's joint velocities (n x 1) [rad/s]. Real-time safe: yes.
@@ -213,33 +217,24 @@ class ManipulatorSimulation {
   void rk4Step(double h);
   void solveFriction(double h);
   void recordReading();
-  std::size_t readIndex() const {
-    return static_cast<std::size_t>((head_ + kMaxSensorDelay + 1 - delay_) % (kMaxSensorDelay + 1));
-  }
+  // The oldest reading of the ring (slots 0..delay_), the one the sensor delay gives.
+  std::size_t readIndex() const { return static_cast<std::size_t>(head_ == delay_ ? 0 : head_ + 1); }
   void externalTorque();
   void takePayload() noexcept;  // the payload of setPayload(), at the start of a step
   void dynamics(const JointVector& tau);  // forward dynamics with the payload: data_.qdd, data_.massMatrix
   const JointMatrix& plantMassMatrix();   // the mass matrix at q_ with motor inertia and the payload
 
-  struct Payload;  // the unit point-mass models by centre and the hand-over
-  std::unique_ptr<Payload> payload_;
-  double stepMass_ = 0;      // the payload of the current step [kg]
-  int stepCentre_ = -1;      // its unit model (index into Payload's), -1: none
-  JointVector payloadBias_;  // scratch: the arm's torques less the payload's bias
-  JointVector zero_;         // zero accelerations (the payload's bias torques)
-  JointMatrix payloadMass_;  // scratch: the mass matrix with the payload
-
-  std::unique_ptr<const ManipulatorModel> own_;  // the plant's model when it deviates
+  // What every step reads and writes comes first, and what only some steps use (a payload, link
+  // wrenches, a sensor delay) last: with hundreds of arms in one servo cycle, the pages and cache
+  // lines an arm's step touches are the cost (docs/realtime.md).
+  std::unique_ptr<const ManipulatorModel> own_;  // the plant's model when it deviates (before model_)
   const ManipulatorModel& model_;
-  ManipulatorData data_;
   JointVector q_, qd_, qdd_, tauTotal_, tauExt_, tauApplied_, coulombPos_, coulombNeg_, brakeTorque_, viscous_;
   // Scratch of the steps: implicit diagonal, right-hand side, residual, friction bounds, RK4 stages.
   JointVector diag_, rhs_, residual_, upper_, lower_, q0_, v0_, kq_, kv_, sumQ_, sumV_;
   JointMatrix A_, L_;
   std::array<bool, kMaxJoints> engaged_{};  // joints whose stop acts in the current Euler step
   Vector<6> wrench_;
-  std::array<Vector<3>, kMaxJoints> linkPoint_{};
-  std::array<Vector<6>, kMaxJoints> linkWrench_{};
   int linkWrenches_ = 0;  // number of links with a non-zero wrench
   bool brakes_ = false;
   bool hasCoulomb_ = false;
@@ -247,11 +242,26 @@ class ManipulatorSimulation {
   int lastSubsteps_ = 1;
   SimulationIntegrator integrator_ = SimulationIntegrator::RK4;
   DynamicsOptions options_;
-  // Sensors: a ring of the last kMaxSensorDelay + 1 readings; head_ is the newest.
+  double stepMass_ = 0;      // the payload of the current step [kg]
+  int stepCentre_ = -1;      // its unit model (index into Payload's), -1: none
+  // Sensors: a ring of the last delay_ + 1 readings (slots 0..delay_); head_ is the newest. Without
+  // a delay every step writes and reads slot 0.
   JointVector countsPerRadian_, encoderOffset_;
   int delay_ = 0;
   int head_ = 0;
-  std::array<JointVector, kMaxSensorDelay + 1> readPosition_{}, readVelocity_{};
+  struct Reading {
+    JointVector position, velocity;
+  };
+  std::array<Reading, kMaxSensorDelay + 1> readings_{};
+  ManipulatorData data_;  // its per-link arrays are used from the start (links 1..n)
+
+  struct Payload;  // the unit point-mass models by centre and the hand-over
+  std::unique_ptr<Payload> payload_;
+  JointVector payloadBias_;  // scratch: the arm's torques less the payload's bias
+  JointVector zero_;         // zero accelerations (the payload's bias torques)
+  JointMatrix payloadMass_;  // scratch: the mass matrix with the payload
+  std::array<Vector<3>, kMaxJoints> linkPoint_{};
+  std::array<Vector<6>, kMaxJoints> linkWrench_{};
 };
 
 /// Creates the simulated plant of a manipulator from its rp.cfg section (which may be null): the

@@ -39,24 +39,28 @@ struct ManipulatorData {
   std::unique_ptr<ManipulatorData> chain;
 
   /// @cond INTERNAL
+  // The scratch the servo cycle's algorithms (kinematics, gravity, the composite-rigid-body
+  // forward dynamics) use comes first, what the others use last: with hundreds of arms in one
+  // cycle, the pages and cache lines each arm touches are the cost (docs/realtime.md).
   // Scratch of the recursive Newton-Euler algorithm, per link, in link coordinates.
   std::array<Matrix<3, 3>, kMaxJoints> R;       // rotation of A_i
   std::array<Vector<3>, kMaxJoints> pstar;      // origin of frame i from frame i-1, in frame i
   std::array<Vector<3>, kMaxJoints> w, wd, vd;  // angular velocity, acceleration, linear acceleration
   std::array<Vector<3>, kMaxJoints> F, N;       // inertial force and moment at the centre of mass
-  JointVector scratchTau, zero, unitColumn;
-  // Scratch of the articulated-body algorithm, per link, at the link frame's origin in link
-  // coordinates; spatial vectors as (angular; linear).
-  std::array<Eigen::Matrix<double, 6, 6>, kMaxJoints> articulatedInertia;
-  std::array<Eigen::Matrix<double, 6, 1>, kMaxJoints> biasForce, motionSubspace, biasAcceleration, inertiaTimesS;
-  JointVector abaD, abaU;
+  JointVector scratchTau;
   // Scratch of forwardDynamics() and massMatrix(), per link, in world coordinates at the world
   // origin: the mass moment m c and the rotational inertia about the origin (the spatial forces
-  // of the velocity products go into biasForce).
+  // of the velocity products go into biasForce), and (also of the articulated-body algorithm,
+  // at the link frame's origin in link coordinates) spatial vectors as (angular; linear).
   std::array<Vector<3>, kMaxJoints> massMoment;
   std::array<Matrix<3, 3>, kMaxJoints> originInertia;
+  std::array<Eigen::Matrix<double, 6, 1>, kMaxJoints> biasForce, motionSubspace, inertiaTimesS;
   JointVector bias;  // h(q, qd) of the last forwardDynamics()
   JointMatrix ldl;   // massMatrix = L D L^T: L strictly below the diagonal (unit diagonal), D on it
+  // Scratch of the articulated-body algorithm and of the Newton-Euler mass matrix.
+  std::array<Eigen::Matrix<double, 6, 6>, kMaxJoints> articulatedInertia;
+  std::array<Eigen::Matrix<double, 6, 1>, kMaxJoints> biasAcceleration;
+  JointVector abaD, abaU, zero, unitColumn;
   // With mimic joints: the chain's joint values, speeds, accelerations and torques.
   JointVector chainQ, chainQd, chainQdd, chainTau;
   /// @endcond
