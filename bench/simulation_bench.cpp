@@ -136,42 +136,34 @@ double freeMotionError(const ManipulatorModel& arm, SimulationIntegrator integra
   return (run(integrator, 1e-3) - reference[model.getName()]).cwiseAbs().maxCoeff();
 }
 
-// One servo cycle with the given integrator; counters: the free-motion accuracy above.
-void servoCycle(benchmark::State& s, SimulationIntegrator integrator) {
-  Arm& a = arm(s);
-  a.sim->setIntegrator(integrator);
-  a.sim->setState(a.model->getHomePosition(), JointVector(a.model->getNumberOfJoints()));
-  for (auto _ : s) {
-    a.control(a.sim->getPosition(), a.sim->getVelocity());
-    a.sim->step(a.tau, 1e-3);
-    benchmark::DoNotOptimize(a.sim->getPosition().data());
-  }
-  s.counters["error_2s_rad"] = freeMotionError(*a.model, integrator);
-  s.counters["arms_per_core"] = benchmark::Counter(1e-3, benchmark::Counter::kIsIterationInvariantRate);
-}
-void ServoCycle_rpEuler(benchmark::State& s) { servoCycle(s, SimulationIntegrator::Euler); }
-void ServoCycle_rpRK4(benchmark::State& s) { servoCycle(s, SimulationIntegrator::RK4); }
-
-// One servo cycle of an arm in motion, as bench/arms_per_core's arms move: the target swings
-// 0.1 rad at 0.5 Hz on joints 1-3 about the start, the other joints held, so some joints slide
-// and others stick (the friction solve's harder case; the cycles above end at rest).
-void servoCycleMoving(benchmark::State& s, SimulationIntegrator integrator) {
+// One servo cycle with the given integrator; counters: the free-motion accuracy above. `moving`:
+// the arm in motion, as bench/arms_per_core's arms move - the target swings 0.1 rad at 0.5 Hz on
+// joints 1-3 about the start, the other joints held, so some joints slide and others stick (the
+// friction solve's harder case; without it the arm comes to rest at the target).
+void servoCycle(benchmark::State& s, SimulationIntegrator integrator, bool moving = false) {
   Arm& a = arm(s);
   a.sim->setIntegrator(integrator);
   const JointVector start = a.target;
-  a.sim->setState(start, JointVector(a.model->getNumberOfJoints()));
+  a.sim->setState(moving ? start : a.model->getHomePosition(), JointVector(a.model->getNumberOfJoints()));
   long k = 0;
   for (auto _ : s) {
-    const double swing = 0.1 * std::sin(2 * 3.14159265358979 * 0.5 * 1e-3 * static_cast<double>(k++));
-    for (int i = 0; i < 3; ++i) a.target(i) = start(i) + swing;
+    if (moving) {
+      const double swing = 0.1 * std::sin(2 * 3.14159265358979 * 0.5 * 1e-3 * static_cast<double>(k++));
+      for (int i = 0; i < 3; ++i) a.target(i) = start(i) + swing;
+    }
     a.control(a.sim->getPosition(), a.sim->getVelocity());
     a.sim->step(a.tau, 1e-3);
     benchmark::DoNotOptimize(a.sim->getPosition().data());
   }
   a.target = start;
+  if (moving) return;
+  s.counters["error_2s_rad"] = freeMotionError(*a.model, integrator);
+  s.counters["arms_per_core"] = benchmark::Counter(1e-3, benchmark::Counter::kIsIterationInvariantRate);
 }
-void ServoCycle_rpEulerMoving(benchmark::State& s) { servoCycleMoving(s, SimulationIntegrator::Euler); }
-void ServoCycle_rpRK4Moving(benchmark::State& s) { servoCycleMoving(s, SimulationIntegrator::RK4); }
+void ServoCycle_rpEuler(benchmark::State& s) { servoCycle(s, SimulationIntegrator::Euler); }
+void ServoCycle_rpRK4(benchmark::State& s) { servoCycle(s, SimulationIntegrator::RK4); }
+void ServoCycle_rpEulerMoving(benchmark::State& s) { servoCycle(s, SimulationIntegrator::Euler, true); }
+void ServoCycle_rpRK4Moving(benchmark::State& s) { servoCycle(s, SimulationIntegrator::RK4, true); }
 
 // The simulation step alone (no control law), each integrator, next to Part_MuJoCoStep.
 void stepOnly(benchmark::State& s, SimulationIntegrator integrator) {
