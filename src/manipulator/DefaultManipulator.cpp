@@ -58,6 +58,19 @@ constexpr double kRestDuration = 0.05;  // [s] at rest before the power goes off
 constexpr double kShutdownTimeout = 3.0;  // [s] longest damped hold
 constexpr int kMaxCatchUpSteps = 1000;    // longest stall the simulation integrates, in periods
 constexpr double kSwitchRestVelocity = 0.01;  // [rad/s] at rest enough to leave the hardware
+constexpr double kVelocityCutoffHz = 50.0;    // a hardware arm's velocity filter (second order)
+
+// What a test for rest may ask of a hardware arm's velocity, at least `floor` [rad/s]. The velocity
+// is the encoders' backward difference through a second-order Butterworth low-pass at
+// kVelocityCutoffHz (readHardware()), which answers a step of one count with a pulse peaking at
+// wc e^(-pi/4) counts per second, wc = 2 pi fc (the peak of the filter's impulse response
+// sqrt(2) wc e^(-wc t/sqrt(2)) sin(wc t/sqrt(2))): 0.0072 rad/s at the Puma's 20000 counts/rad. An
+// arm held still dithers by a count or two, so anything below three counts' pulse is rest: a
+// stricter test would refuse or wait on a still arm at random.
+double restTolerance(double floor, double countsPerRadian) {
+  const double countPulse = 2.0 * M_PI * kVelocityCutoffHz * std::exp(-M_PI / 4.0) / countsPerRadian;
+  return std::max(floor, 3.0 * countPulse);
+}
 const std::string kServoControlCommand = "Servo Control: ";  // + the control's name
 
 // A setpoint that an arm standing at q can take over without a jump: within these of it.
@@ -170,7 +183,7 @@ std::unique_ptr<DefaultManipulator::Setup> DefaultManipulator::makeSetup(bool si
         if (section->has("countsPerRadian")) setup->countsPerRadian = section->getNumbers("countsPerRadian").at(0);
         setup->board = std::make_unique<HwServerIoBoard>(section->getWord("hwserver"));  // throws IoException if absent
       }
-      setup->velocity = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
+      setup->velocity = std::make_unique<Differentiator<JointVector>>(getPeriod(), kVelocityCutoffHz, 2);
     }
   }
   setup->data = std::make_unique<ManipulatorData>(*setup->model);
@@ -203,7 +216,8 @@ DefaultManipulator::SetupResult DefaultManipulator::checkSetup(const Setup& setu
     return SetupResult::kDriven;
   }
   // Leaving the hardware switches its amplifiers off: only with the arm at rest.
-  if (board_ != nullptr && !setup.keepBoard && power_ && qd_.cwiseAbs().maxCoeff() > kSwitchRestVelocity)
+  if (board_ != nullptr && !setup.keepBoard && power_ &&
+      qd_.cwiseAbs().maxCoeff() > restTolerance(kSwitchRestVelocity, countsPerRadian_))
     return SetupResult::kMoving;
   // The new hardware must answer before it takes over.
   if (setup.board != nullptr) {
@@ -803,7 +817,7 @@ void DefaultManipulator::enterControl() {
   // loop starts the filter afresh with its first reading (not with the joints read at
   // construction: divided by one period, the motion since then would be a velocity spike).
   if (board_) {
-    if (velocity_->getSamplePeriod() != getPeriod()) velocity_ = std::make_unique<Differentiator<JointVector>>(getPeriod(), 50.0, 2);
+    if (velocity_->getSamplePeriod() != getPeriod()) velocity_ = std::make_unique<Differentiator<JointVector>>(getPeriod(), kVelocityCutoffHz, 2);
     velocity_->reset();
     lastSampleTime_ = 0;
   }
@@ -827,8 +841,13 @@ void DefaultManipulator::exitControl() {
 
 void DefaultManipulator::readInputs() {
   const double t = getTime();
-  // When the joints are read (StateSnapshot::readTime): a clock read, no system call (vDSO).
-  readTime_ = getClock().isSimulated() ? t : getClock().getTime();
+  // When the joints are read (StateSnapshot::readTime): a clock read, no system call (vDSO), for
+  // hardware. A simulated arm's joints are its state at the cycle's time t, however late the cycle
+  // runs (a late cycle integrates to t, below, and a cycle after skipped deadlines catches up to
+  // its t): stamped with the clock instead, a late sample and the next would carry times that do
+  // not match their motion, and a reader differentiating over the stamps (a program driving this
+  // arm by torque over ROS 2) would see a velocity spike of 40 % at 1.6 rad/s after a 3 ms stall.
+  readTime_ = getClock().isSimulated() || !board_ ? t : getClock().getTime();
   const double dt = getPeriod();
   const int n = model_->getNumberOfJoints();
 
@@ -997,7 +1016,8 @@ void DefaultManipulator::control() {
   // Shutdown: at rest for a while (or timed out), then power off.
   if (shutdownPhase_.load(std::memory_order_relaxed) == 1) {
     if (shutdownStart_ == 0) shutdownStart_ = t > 0 ? t : 1e-9;
-    restTime_ = qd_.cwiseAbs().maxCoeff() < kRestVelocity ? restTime_ + dt : 0;
+    const double rest = board_ ? restTolerance(kRestVelocity, countsPerRadian_) : kRestVelocity;
+    restTime_ = qd_.cwiseAbs().maxCoeff() < rest ? restTime_ + dt : 0;
     if (restTime_ >= kRestDuration || t - shutdownStart_ > kShutdownTimeout || !power_) {
       power_ = false;
       sim_->setBrakes(true);

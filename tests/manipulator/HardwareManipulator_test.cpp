@@ -9,6 +9,8 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
+#include <memory>
 #include <thread>
 
 #include "ChildProcess.hpp"
@@ -110,6 +112,81 @@ TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
     EXPECT_FALSE(ObjectManager::isShutdownRequested()) << ObjectManager::getShutdownReason();
     EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
     puma.clearTrajectoryGenerator();
+  }
+  RoboticPlatform::setSimulationModeOn();
+  RoboticPlatform::useSimulatedClock();
+  ObjectManager::resetShutdown();
+}
+
+// A Puma held still behind the server dithers by an encoder count now and then (5e-5 rad), which
+// the velocity filter shows as pulses of up to 0.0072 rad/s a count. Still is at rest all the same:
+// leaving the hardware is accepted, and a shutdown's hold powers the arm off once it has been still
+// for 50 ms, not at the hold's 3 s timeout. (Both asked for less than the pulse of one count.)
+TEST(HardwareManipulator, AnArmHeldStillIsAtRestWhateverItsEncodersDither) {
+  test::ChildProcess server = startServer("test-rest");
+  ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
+  double holdSeconds = 0;
+  {
+    auto puma = std::make_unique<Puma560>("leader");
+    JointVector target = puma->getModel().getHomePosition();
+    target(0) += 0.05;
+    target(2) -= 0.05;
+    {
+      StepTo step(target);
+      puma->setTrajectoryGenerator(step);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+      puma->clearTrajectoryGenerator();
+    }
+    double dither = 0;  // the largest velocity read while the arm holds still
+    for (int i = 0; i < 500; ++i) {
+      dither = std::max(dither, puma->getJointVelocity().cwiseAbs().maxCoeff());
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    EXPECT_LT((puma->getJointPosition() - target).cwiseAbs().maxCoeff(), 0.01) << "holding at the target";
+    std::printf("largest velocity read while held still: %.5f rad/s\n", dither);
+    EXPECT_NO_THROW(puma->setSimulationModeOn()) << "a still arm is at rest";
+    EXPECT_FALSE(puma->usesHardware());
+    EXPECT_NO_THROW(puma->setSimulationModeOff()) << "and back to the hardware";
+    ASSERT_TRUE(puma->usesHardware());
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const auto start = std::chrono::steady_clock::now();
+    puma.reset();  // the shutdown's hold: powered off once still
+    holdSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  EXPECT_LT(holdSeconds, 1.0) << "the hold waited for a rest that encoder dither never gave";
+  RoboticPlatform::setSimulationModeOn();
+  RoboticPlatform::useSimulatedClock();
+  ObjectManager::resetShutdown();
+}
+
+// StateSnapshot::readTime of an arm behind hardware, which the ROS 2 bridge stamps joint states
+// with: on the real clock, when the cycle read the encoders, after the cycle's scheduled time and
+// never later than the moment the snapshot is taken. (A simulated arm's is the cycle's time:
+// DefaultManipulator_test.)
+TEST(HardwareManipulator, TheStateSnapshotSaysWhenTheCycleReadTheEncoders) {
+  test::ChildProcess server = startServer("test-read");
+  ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
+  {
+    Puma560 puma("leader");
+    ASSERT_TRUE(puma.usesHardware());
+    const Clock& clock = puma.getControlProgram()->getClock();
+    double lastTime = -1;
+    int cycles = 0;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (cycles < 20 && std::chrono::steady_clock::now() < deadline) {
+      StateSnapshot s;
+      ASSERT_TRUE(puma.getStateSnapshot(s));
+      const double now = clock.getTime();
+      if (s.time == lastTime || s.time == 0) {
+        std::this_thread::sleep_for(std::chrono::microseconds(300));
+        continue;
+      }
+      lastTime = s.time;
+      ++cycles;
+      EXPECT_GT(s.readTime, s.time) << "read before the cycle's scheduled time";
+      EXPECT_LE(s.readTime, now) << "read after the snapshot was taken";
+    }
+    EXPECT_GE(cycles, 20);
   }
   RoboticPlatform::setSimulationModeOn();
   RoboticPlatform::useSimulatedClock();

@@ -54,9 +54,9 @@ inline constexpr int kMaxStateValues = 128;
 /// read by the GUI (see TripleBuffer). Trivially copyable.
 struct StateSnapshot {
   double time = 0;           ///< clock time of the cycle that published it [s]
-  /// Clock time at which that cycle read its inputs (the arm's joints) [s]: on a real clock later
-  /// than `time` (the cycle's scheduled time) by the loop's wake-up latency and the work before the
-  /// read; on a simulated clock equal to `time`; 0 where the object does not say.
+  /// Clock time its inputs (the arm's joints) hold for [s]: read from hardware, when the cycle read
+  /// them, later than `time` (the scheduled time) by the wake-up latency and the work before; of a
+  /// simulation (its state integrated to `time`) or on a simulated clock, `time`; 0 if not said.
   double readTime = 0;
   std::uint64_t cycle = 0;   ///< cycle number
   int size = 0;              ///< number of valid entries in `values`

@@ -268,7 +268,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
  private:
   struct PublishedState {
     double time = 0;
-    double readTime = 0;  // the clock when the cycle read the joints
+    double readTime = 0;  // the time the cycle's joints hold for
     std::uint64_t cycle = 0;  // the program's cycle count when the cycle published it
     int n = 0;
     bool power = false;
@@ -356,7 +356,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   bool power_ = false;
   double restTime_ = 0, shutdownStart_ = 0;
   double lastCycleTime_ = -1;   // time of the previous cycle (-1 before the first)
-  double readTime_ = 0;         // servo thread: the clock when this cycle read the joints
+  double readTime_ = 0;         // servo thread: the time this cycle's joints hold for
   bool poweredOn_ = false;      // loop: the power came on in this cycle's read phase
   bool readFailed_ = false;     // loop: this cycle's reading is not a number (control() skipped)
   std::int64_t lastSampleTime_ = 0;  // the board's time of the joints last read [ns] (0: none, or not known)
