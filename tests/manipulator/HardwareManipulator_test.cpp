@@ -3,6 +3,7 @@
 // Encoder counts in, DAC volts out, amplifier enable; on the real clock.
 #include <gtest/gtest.h>
 
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -68,8 +69,11 @@ TEST(HardwareManipulator, PumaBehindAHardwareServerHoldsMovesAndShutsDownWhenThe
     EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
     puma.clearTrajectoryGenerator();
 
-    // The server dies: the next reads fail and the servo loop requests a safe shutdown.
+    // The server dies: the next reads fail and the servo loop requests a safe shutdown. (Killed,
+    // it leaves its shared memory behind: removed here, as its operator would.)
     server.signal(SIGKILL);
+    EXPECT_EQ(::shm_unlink(("/rp-hwserver-test-arm-" + std::to_string(::getpid())).c_str()), 0)
+        << "the killed server's shared memory (HwServerShm.hpp's name)";
     ASSERT_TRUE(ObjectManager::waitForShutdown(5));
     EXPECT_NE(puma.getErrorStatus().message.find("hardware failure"), std::string::npos)
         << puma.getErrorStatus().message;
