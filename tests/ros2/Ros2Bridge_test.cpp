@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -445,6 +446,7 @@ class CycleRecorder : public ControlProgram {
 // At the servo rate (`rate servo`) the bridge publishes every servo cycle as it ends: each sample
 // is a cycle not published before, stamped with the time that cycle read the joints, and most
 // samples are the cycle after the one before (at a set rate of 100 Hz they are ten apart).
+// (The arm is simulated: its read times are its cycles' times, StateSnapshot::readTime.)
 // The stamps are compared with the read times the servo cycles themselves recorded: a stamp is a
 // cycle's read time plus the offset from the arm's clock to the wall clock, to the nanosecond, and
 // that offset stays the same between the bridge's measurements of it (one a second). So the test
@@ -473,6 +475,14 @@ TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithIts
   }
   ASSERT_GE(stamps.size(), 400u);
   recorder.stop();
+  // The offset from the arm's clock to the wall clock, as the bridge measures it (to microseconds):
+  // a simulated arm's read times are its cycles' times, exactly a period apart, so offsets a whole
+  // number of periods apart match the samples equally well; the true one is the nearest to this.
+  const Clock& armClock = puma.getControlProgram()->getClock();
+  const double before = armClock.getTime();
+  const std::int64_t wall = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                std::chrono::system_clock::now().time_since_epoch()).count();
+  const std::int64_t approximateOffset = wall - std::llround(0.5 * (before + armClock.getTime()) * 1e9);
   const auto& cycles = recorder.readTimes();
   ASSERT_GE(cycles.size(), 400u);
   for (std::size_t i = 1; i < cycles.size(); ++i)
@@ -495,7 +505,8 @@ TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithIts
       const std::int64_t offset = stamps[k] - t;
       std::size_t count = 0;
       for (std::size_t j = k + 1; j <= k + next; ++j) count += cycleAt(stamps[j] - offset).has_value();
-      if (count > bestCount || !best) {
+      if (count > bestCount || !best ||
+          (count == bestCount && std::llabs(offset - approximateOffset) < std::llabs(*best - approximateOffset))) {
         best = offset;
         bestCount = count;
       }
