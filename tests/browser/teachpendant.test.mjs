@@ -56,6 +56,14 @@ describe('rp-teachpendant', () => {
   });
 
   it('moves back to a stored position with the trajectory generator', async () => {
+    // The table's rows outlive state updates (the page reads the state every 500 ms). Before, each
+    // update replaced every button: a click on Go could land on a button just taken out of the page.
+    await ctx.page.evaluate(() => {
+      window.goBefore = document.querySelector('#positions tr[data-index="0"] button.go');
+      window.stateBefore = window.rp.state;
+    });
+    await waitInPage(ctx.page, () => window.rp.state !== window.stateBefore);
+    assert.ok(await ctx.page.evaluate(() => window.goBefore.isConnected), 'a state update replaced the Go button');
     await ctx.page.click('#positions tr[data-index="0"] button.go');
     await waitInPage(ctx.page, () => window.rp.state.busy || window.rp.state.zeroGravity === false);
     await nearStored(0, 0.01);

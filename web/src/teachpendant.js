@@ -32,29 +32,44 @@ function showState(s) {
   zeroG.textContent = `Zero gravity: ${s.zeroGravity ? 'on' : 'off'}`;
   zeroG.classList.toggle('active', s.zeroGravity);
   tpStatus.textContent = s.busy ? `moving to ${s.target}` : '';
+  // The table is updated in place: a row's elements live as long as its position, so a click on
+  // Go or Delete is not lost to a state update replacing the button under the pointer (the page
+  // reads the state every 500 ms, and after each request).
   const selected = new Set([...tbody.querySelectorAll('input:checked')].map((b) => b.dataset.name));
-  tbody.replaceChildren(...s.positions.map((p, i) => {
-    const tr = document.createElement('tr');
-    tr.dataset.index = String(i);
-    const box = document.createElement('input');
-    box.type = 'checkbox';
-    box.dataset.name = p.name;
-    box.checked = selected.has(p.name);
-    const go = document.createElement('button');
-    go.textContent = 'Go';
-    go.className = 'go';
-    go.onclick = () => send('goto', { index: i });
-    const del = document.createElement('button');
-    del.textContent = 'Delete';
-    del.onclick = () => send('delete', { index: i });
-    const cells = [box, p.name, p.q.map((q) => (q * DEG).toFixed(1)).join(' '), go, del].map((c) => {
-      const td = document.createElement('td');
-      td.append(c);
-      return td;
-    });
-    tr.append(...cells);
-    return tr;
+  while (tbody.rows.length > s.positions.length) tbody.lastElementChild.remove();
+  s.positions.forEach((p, i) => {
+    const tr = tbody.rows[i] || tbody.appendChild(positionRow(i));
+    const [boxCell, nameCell, qCell] = tr.cells;
+    const box = boxCell.firstElementChild;
+    if (box.dataset.name !== p.name) {
+      box.dataset.name = p.name;
+      box.checked = selected.has(p.name);
+    }
+    if (nameCell.textContent !== p.name) nameCell.textContent = p.name;
+    const q = p.q.map((x) => (x * DEG).toFixed(1)).join(' ');
+    if (qCell.textContent !== q) qCell.textContent = q;
+  });
+}
+
+// The row of stored position i: selection box, name, joint angles [deg], Go and Delete.
+function positionRow(i) {
+  const tr = document.createElement('tr');
+  tr.dataset.index = String(i);
+  const box = document.createElement('input');
+  box.type = 'checkbox';
+  const go = document.createElement('button');
+  go.textContent = 'Go';
+  go.className = 'go';
+  go.onclick = () => send('goto', { index: i });
+  const del = document.createElement('button');
+  del.textContent = 'Delete';
+  del.onclick = () => send('delete', { index: i });
+  tr.append(...[box, '', '', go, del].map((c) => {
+    const td = document.createElement('td');
+    td.append(c);
+    return td;
   }));
+  return tr;
 }
 
 zeroG.onclick = () => send('zeroGravity', !(state && state.zeroGravity));
