@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <cmath>
 #include <limits>
@@ -27,6 +28,16 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 
 // Unique per process and test, so that ctest -j runs do not collide.
 std::string uniqueName(const char* what) { return std::string("test-") + what + "-" + std::to_string(::getpid()); }
+
+// Whether the process at `proc` (its /proc directory) has a descriptor open on the file `path`.
+bool holdsFileNamed(const std::string& proc, const std::string& path) {
+  std::error_code ec;
+  for (std::filesystem::directory_iterator fd(proc + "/fd", ec), end; !ec && fd != end; fd.increment(ec)) {
+    std::error_code e;
+    if (std::filesystem::read_symlink(fd->path(), e) == path) return true;
+  }
+  return false;
+}
 
 // These tests are not about the client watchdog (HwServerWatchdog_test is): a watchdog time long
 // enough that a client descheduled on a loaded machine keeps its outputs.
@@ -145,9 +156,13 @@ TEST(HwServer, ASegmentLeftByADeadServerIsReplacedEvenIfItsPidLivesOn) {
   bool replaced = false;
   for (int i = 0; i < 1000; ++i) {  // bounded: 10 s
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    std::ifstream comm("/proc/" + std::to_string(child) + "/comm");
+    // The exec is over when the process is `sleep` and holds no descriptor of the segment (the
+    // kernel names the process before it closes the descriptors marked close-on-exec, which
+    // release the server's lock: waiting for the name alone once met the lock still held).
+    const std::string proc = "/proc/" + std::to_string(child);
+    std::ifstream comm(proc + "/comm");
     std::string what;
-    if (!(comm >> what) || what != "sleep") continue;
+    if (!(comm >> what) || what != "sleep" || holdsFileNamed(proc, "/dev/shm/rp-hwserver-" + name)) continue;
     SimulatedIoBoard board;
     HwServer server(board, name, 100.0);
     EXPECT_NO_THROW(server.start()) << "the dead server's segment was not replaced";
