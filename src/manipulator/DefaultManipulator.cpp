@@ -842,7 +842,7 @@ void DefaultManipulator::exitControl() {
 void DefaultManipulator::readInputs() {
   const double t = getTime();
   // When the joints are read (StateSnapshot::readTime): a clock read, no system call (vDSO), for
-  // hardware. A simulated arm's joints are its state at the cycle's time t, however late the cycle
+  // hardware (a hardware server's sample time instead, below). A simulated arm's joints are its state at the cycle's time t, however late the cycle
   // runs (a late cycle integrates to t, below, and a cycle after skipped deadlines catches up to
   // its t): stamped with the clock instead, a late sample and the next would carry times that do
   // not match their motion, and a reader differentiating over the stamps (a program driving this
@@ -891,7 +891,16 @@ void DefaultManipulator::readInputs() {
     if (power_) activeControl_ = nullptr;  // a hand-over: activate() again below, holding where the arm is
   }
   if (board_) {
-    if (!readHardware(lastCycleTime_ >= 0 && t > lastCycleTime_ ? t - lastCycleTime_ : dt)) ioFailure("reading the encoders", 0);
+    if (!readHardware(lastCycleTime_ >= 0 && t > lastCycleTime_ ? t - lastCycleTime_ : dt)) {
+      ioFailure("reading the encoders", 0);
+    } else if (lastSampleTime_ > 0) {
+      // A board that samples on its own clock (the hardware server): the joints hold for the
+      // sample's time, not for this read. A cycle that finds no new sample (the server late)
+      // keeps the joints and their time: a new stamp on old joints would be a velocity dip to a
+      // reader differentiating over the stamps, and the next sample a spike.
+      if (const auto* real = dynamic_cast<const RealClock*>(&getClock()))
+        readTime_ = 1e-9 * static_cast<double>(lastSampleTime_ - real->epochNanoseconds());
+    }
   } else {
     // On the real clock a cycle delayed by a busy machine skips deadlines; the arm moved on under
     // the last torque (still in tau_) meanwhile, as a real one does: integrate that time, in

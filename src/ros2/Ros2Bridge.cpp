@@ -192,7 +192,7 @@ struct ArmEntry {
   std::string lastState;
   std::chrono::steady_clock::time_point lastStateTime;
   bool seen = false;
-  double lastTime = std::numeric_limits<double>::quiet_NaN();  // the servo cycle (its time) published last
+  double lastTime = std::numeric_limits<double>::quiet_NaN();  // the joints' time (StateSnapshot) published last
   WallClockMapping wall;  // the arm's clock to the stamps' wall clock
   dds_entity_t trajectoryReader = 0;
   std::unique_ptr<TimedTrajectoryGenerator> generator;  // connected to the arm on the first trajectory taken
@@ -659,8 +659,11 @@ void Ros2Bridge::Impl::cycle() {
     builtin_interfaces_msg_dds__Time_ stamp = publishedAt;
     bool fresh = true;  // a sample to write (at the servo rate: only of a servo cycle not yet written)
     if (m->getStateSnapshot(snap) && snap.size >= 3 * n + 1) {
-      fresh = !servo || snap.time != e.lastTime;
-      e.lastTime = snap.time;
+      // At the servo rate, each sample of the joints once: a cycle that read an arm's hardware
+      // sample again (its server late) keeps that sample's time and publishes nothing.
+      const double held = snap.readTime > 0 ? snap.readTime : snap.time;
+      fresh = !servo || held != e.lastTime;
+      e.lastTime = held;
       for (int i = 0; i < n; ++i) {
         q(i) = snap.values[i];
         qd(i) = snap.values[n + i];

@@ -62,8 +62,10 @@ struct Ros2IoBoard::Impl {
   dds_entity_t participant = 0, jointStates = 0, state = 0, effort = 0;
 
   // Cyclone's receive thread (the listeners) -> the servo thread: a sequence lock. sampleTime is
-  // the stored sample's stamp [ns], -1 while one is stored, 0 before the first.
+  // the stored sample's time on CLOCK_MONOTONIC (its stamp plus stampToLocal) [ns], -1 while one
+  // is stored, 0 before the first.
   std::atomic<std::int64_t> sampleTime{0};
+  std::int64_t stampToLocal = 0;  // the listener's own: the first sample's receipt minus its stamp [ns]
   std::array<std::atomic<std::int64_t>, kMaxJoints> counts{};
   std::atomic<std::int64_t> lastReceipt{0};  // steady clock [ns] of the last sample of the arm
   std::int64_t lastStamp = 0;                // the listener's own: the last sample time stored
@@ -138,15 +140,25 @@ struct Ros2IoBoard::Impl {
         // The sample's time: the remote cycles' stamps, so that the velocity is differentiated over
         // the remote arm's own cycle times (receipt times carry the network's jitter). Where a stamp
         // does not follow on (the remote wall clock stepped back, or ahead by more than a second),
-        // the step is the last good one: one remote cycle.
+        // the step is the last good one: one remote cycle. A stamp that comes again is the same
+        // sample again (an arm's hardware sample its server has not renewed yet): it keeps its
+        // time, so the reader sees no new sample rather than joints standing still for a cycle.
         const std::int64_t remoteStamp = static_cast<std::int64_t>(js.header.stamp.sec) * 1000000000 + js.header.stamp.nanosec;
         std::int64_t step = remoteStamp - lastRemoteStamp;
-        if (step <= 0 || step > kLongestStampStep)
+        if (step == 0 && lastStamp != 0) {  // (not counted in the samples: none new)
+          lastReceipt.store(steadyNanoseconds(), std::memory_order_release);
+          return;
+        }
+        if (step < 0 || step > kLongestStampStep)
           step = goodStep;
         else
           goodStep = step;
         lastRemoteStamp = remoteStamp;
-        const std::int64_t stamp = lastStamp == 0 ? std::max<std::int64_t>(remoteStamp, 1) : lastStamp + step;  // never 0 or -1
+        const std::int64_t stamp = lastStamp == 0 ? std::max<std::int64_t>(remoteStamp, 1) : lastStamp + step;
+        // On this machine's CLOCK_MONOTONIC (IoBoard::inputSampleTime()), as received at the first
+        // sample: the steps stay the remote cycles' (two clocks' rates differ by some parts per
+        // million, so the times drift from the receipts by that much).
+        if (lastStamp == 0) stampToLocal = steadyNanoseconds() - stamp;
         lastStamp = stamp;
         if (firstStamp.load(std::memory_order_relaxed) == 0) firstStamp.store(stamp);
         latestStamp.store(stamp);
@@ -159,7 +171,7 @@ struct Ros2IoBoard::Impl {
                                                     std::memory_order_release);
           if (!std::isfinite(q)) setFault("the remote arm " + label + " sent a joint position that is not a number");
         }
-        sampleTime.store(stamp, std::memory_order_release);
+        sampleTime.store(stamp + stampToLocal, std::memory_order_release);  // never 0 or -1
         lastReceipt.store(steadyNanoseconds(), std::memory_order_release);
         ++samples;
       }

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <thread>
@@ -17,6 +18,7 @@
 #include "ChildProcess.hpp"
 #include "SimulatedArmTest.hpp"
 #include "rp/RoboticPlatform.hpp"
+#include "rp/io/HwServerIoBoard.hpp"
 
 namespace rp {
 namespace {
@@ -167,30 +169,69 @@ TEST(HardwareManipulator, AnArmHeldStillIsAtRestWhateverItsEncodersDither) {
 // with: on the real clock, when the cycle read the encoders, after the cycle's scheduled time and
 // never later than the moment the snapshot is taken. (A simulated arm's is the cycle's time:
 // DefaultManipulator_test.)
-TEST(HardwareManipulator, TheStateSnapshotSaysWhenTheCycleReadTheEncoders) {
+// The state snapshot of an arm behind a hardware server holds for the server's sample (its
+// CLOCK_MONOTONIC stamp, on the arm's clock), as another client of the server reads it. While the
+// server is stopped, the cycles go on reading its last sample: they keep that sample's time. (With
+// the time of each read instead, old joints went out under new stamps: to a reader differentiating
+// over them, as a program driving the arm over ROS 2 does, a velocity dip and then a spike.)
+TEST(HardwareManipulator, TheStateSnapshotHoldsForTheServersSample) {
   test::ChildProcess server = startServer("test-read");
   ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
   {
     Puma560 puma("leader");
     ASSERT_TRUE(puma.usesHardware());
-    const Clock& clock = puma.getControlProgram()->getClock();
-    double lastTime = -1;
-    int cycles = 0;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (cycles < 20 && std::chrono::steady_clock::now() < deadline) {
+    const auto* clock = dynamic_cast<const RealClock*>(&puma.getControlProgram()->getClock());
+    ASSERT_NE(clock, nullptr);
+    HwServerIoBoard probe("test-read-" + std::to_string(::getpid()), 500, HwServerIoBoard::Heartbeat::kBackgroundThread);
+    auto onArmsClock = [&](std::int64_t ns) { return 1e-9 * static_cast<double>(ns - clock->epochNanoseconds()); };
+    // The server's latest sample time, read again while the server is storing one (-1); -1 if it
+    // still is after 100 ms (stopped in the middle of a store).
+    auto serversLatest = [&]() -> std::int64_t {
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
+      std::int64_t t = probe.inputSampleTime();
+      while (t < 0 && std::chrono::steady_clock::now() < deadline) t = probe.inputSampleTime();
+      return t;
+    };
+    auto nextCycle = [&](double after) {
       StateSnapshot s;
-      ASSERT_TRUE(puma.getStateSnapshot(s));
-      const double now = clock.getTime();
-      if (s.time == lastTime || s.time == 0) {
-        std::this_thread::sleep_for(std::chrono::microseconds(300));
-        continue;
-      }
-      lastTime = s.time;
-      ++cycles;
-      EXPECT_GT(s.readTime, s.time) << "read before the cycle's scheduled time";
-      EXPECT_LE(s.readTime, now) << "read after the snapshot was taken";
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (puma.getStateSnapshot(s) && s.time <= after && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+      return s;
+    };
+    // Running: each snapshot's joints are a sample the server took before the snapshot was read.
+    StateSnapshot s = nextCycle(0);
+    for (int i = 0; i < 20; ++i) {
+      s = nextCycle(s.time);
+      const std::int64_t ns = serversLatest();
+      ASSERT_GT(ns, 0);
+      const double latest = onArmsClock(ns);
+      EXPECT_GT(s.readTime, 0);
+      EXPECT_LE(s.readTime, latest + 1e-8) << "a sample newer than the server's latest";
+      EXPECT_LT(latest - s.readTime, 0.5) << "a sample half a second old";
     }
-    EXPECT_GE(cycles, 20);
+    // Stopped: 30 ms of cycles read the last sample, and keep its time.
+    std::int64_t lastNs = -1;
+    for (int attempt = 0; attempt < 5 && lastNs < 0; ++attempt) {  // (again if stopped in a store)
+      server.signal(SIGSTOP);
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      lastNs = serversLatest();
+      if (lastNs < 0) server.signal(SIGCONT);
+    }
+    ASSERT_GT(lastNs, 0) << "the server stopped in the middle of storing a sample, five times";
+    const double last = onArmsClock(lastNs);
+    const StateSnapshot first = nextCycle(s.time);
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    const StateSnapshot later = nextCycle(first.time);
+    server.signal(SIGCONT);
+    EXPECT_GE(later.cycle - first.cycle, 10u) << "the servo loop did not run while the server was stopped";
+    EXPECT_NEAR(first.readTime, last, 1e-8);
+    EXPECT_NEAR(later.readTime, last, 1e-8) << "a cycle reading the stopped server's sample again stamped it anew";
+    for (int k = 0; k < 6; ++k) EXPECT_EQ(later.values[k], first.values[k]) << "joint " << k + 1;
+    // Going again: new samples, new times.
+    const StateSnapshot resumed = nextCycle(later.time + 0.02);
+    EXPECT_GT(resumed.readTime, last);
+    EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
   }
   RoboticPlatform::setSimulationModeOn();
   RoboticPlatform::useSimulatedClock();

@@ -28,6 +28,7 @@
 #include <string>
 #include <thread>
 
+#include "ChildProcess.hpp"
 #include "Ros2Fixture.hpp"
 #include "rp/RoboticPlatform.hpp"
 #include "sensor_msgs.h"
@@ -37,6 +38,7 @@
 namespace rp {
 namespace {
 
+using test::Child;
 using test::contains;
 using Ros2BridgeTest = test::Ros2Fixture;
 
@@ -452,16 +454,10 @@ class CycleRecorder : public ControlProgram {
 // that offset stays the same between the bridge's measurements of it (one a second). So the test
 // does not depend on how late the servo thread wakes (hundreds of microseconds under ASan with
 // other tests running).
-TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithItsTime) {
-  Puma560 puma("puma");
-  CycleRecorder recorder(puma);
-  recorder.start();
-  options_.rate = Ros2BridgeOptions::kServoRate;
-  Ros2Bridge bridge("ros", options_);
-  const dds_entity_t r = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
-  std::vector<std::int64_t> stamps;  // [ns]
+// Takes joint_states samples from `r` until `stamps` holds `count` stamps [ns] (at most 20 s).
+void takeStamps(dds_entity_t r, std::vector<std::int64_t>& stamps, std::size_t count) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (stamps.size() < 400 && std::chrono::steady_clock::now() < end) {
+  while (stamps.size() < count && std::chrono::steady_clock::now() < end) {
     void* samples[10] = {nullptr};
     dds_sample_info_t info[10];
     const dds_return_t n = dds_take(r, samples, info, 10, 10);
@@ -473,6 +469,59 @@ TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithIts
     if (n > 0) dds_return_loan(r, samples, n);
     std::this_thread::sleep_for(std::chrono::microseconds(500));
   }
+}
+
+// An arm behind a hardware server (rp-hwserver's emulated Puma), published at the servo rate:
+// each of the server's samples goes out once, stamped with when the server took it. While the
+// server is stopped, the servo cycles read its last sample again: nothing goes out, and the next
+// sample's stamp is the whole stop later. (Before, the old joints went out every cycle under the
+// cycles' new stamps: to a reader differentiating over them, standing still, then a jump.)
+TEST_F(Ros2BridgeTest, AtTheServoRateEachHardwareSampleGoesOutOnceStampedWhenTaken) {
+  const std::string name = "test-bridge-hw-" + std::to_string(::getpid());
+  Child server({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
+  ASSERT_TRUE(contains(server.line(), "serving")) << "the hardware server did not start";
+  RoboticPlatform::setConfiguration(Configuration::parse("[puma]\nclass Puma560\nsimulationMode off\nhwserver " + name + "\n", "rp.cfg"));
+  RoboticPlatform::setSimulationModeOff();  // (the real clock, this suite's)
+  struct Restore {
+    ~Restore() {
+      RoboticPlatform::setSimulationModeOn();
+      RoboticPlatform::setConfiguration(Configuration());
+      ObjectManager::resetShutdown();
+    }
+  } restore;
+  std::vector<std::int64_t> stamps;  // [ns]
+  {
+    Puma560 puma("puma");
+    ASSERT_TRUE(puma.usesHardware());
+    options_.rate = Ros2BridgeOptions::kServoRate;
+    Ros2Bridge bridge("ros", options_);
+    const dds_entity_t r = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
+    takeStamps(r, stamps, 100);
+    ::kill(server.pid, SIGSTOP);
+    std::this_thread::sleep_for(std::chrono::milliseconds(40));
+    ::kill(server.pid, SIGCONT);
+    takeStamps(r, stamps, stamps.size() + 100);
+    EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
+  }
+  ASSERT_GE(stamps.size(), 200u);
+  std::int64_t longest = 0;
+  for (std::size_t i = 1; i < stamps.size(); ++i) {
+    EXPECT_GT(stamps[i], stamps[i - 1]) << "sample " << i << " went out again (or out of order)";
+    longest = std::max(longest, stamps[i] - stamps[i - 1]);
+  }
+  EXPECT_GE(longest, 30000000) << "no sample waited for the stopped server";
+  std::printf("%zu samples, the longest step between stamps %.1f ms\n", stamps.size(), 1e-6 * static_cast<double>(longest));
+}
+
+TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithItsTime) {
+  Puma560 puma("puma");
+  CycleRecorder recorder(puma);
+  recorder.start();
+  options_.rate = Ros2BridgeOptions::kServoRate;
+  Ros2Bridge bridge("ros", options_);
+  const dds_entity_t r = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
+  std::vector<std::int64_t> stamps;  // [ns]
+  takeStamps(r, stamps, 400);
   ASSERT_GE(stamps.size(), 400u);
   recorder.stop();
   // The offset from the arm's clock to the wall clock, as the bridge measures it (to microseconds):

@@ -126,6 +126,40 @@ class Ros2IoBoardTest : public Ros2Fixture {
     EXPECT_NEAR(t(2, 2), -1, 1e-3) << "the gripper points down";
   }
 
+  // A writer of `topic` in the remote arm's namespace, as its bridge's.
+  dds_entity_t writer(const dds_topic_descriptor_t& desc, const std::string& topic) {
+    const std::string name = "rt/" + ns_ + "/" + topic;
+    const dds_entity_t t = dds_create_topic(participant_, &desc, name.c_str(), nullptr, nullptr);
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
+    dds_delete_qos(qos);
+    EXPECT_GT(w, 0) << name;
+    return w;
+  }
+  // A joint_states sample of the remote arm `arm` with its one joint `joint1` at q [rad], stamped
+  // `stamp` [ns since the epoch].
+  static void writeJoint(dds_entity_t joints, std::int64_t stamp, double q) {
+    sensor_msgs_msg_dds__JointState_ js{};
+    js.header.stamp.sec = static_cast<int32_t>(stamp / 1000000000);
+    js.header.stamp.nanosec = static_cast<uint32_t>(stamp % 1000000000);
+    js.header.frame_id = const_cast<char*>("");
+    char name[] = "arm_joint1";
+    char* names[] = {name};
+    double position[] = {q}, zero[] = {0.0};
+    js.name = {1, 1, names, false};
+    js.position = {1, 1, position, false};
+    js.velocity = {1, 1, zero, false};
+    js.effort = {1, 1, zero, false};
+    dds_write(joints, &js);
+  }
+  // The remote arm's state: powered, no fault.
+  static void writePowerOn(dds_entity_t state) {
+    std_msgs_msg_dds__String_ s{};
+    s.data = const_cast<char*>(R"({"power":true,"errorCode":0,"shutdown":false,"effortsRefused":0})");
+    dds_write(state, &s);
+  }
+
   ScratchDirectory dir_{"rp_ros2_board_test_", "scratch"};
   std::string ns_;
   dds_entity_t domain_ = 0, jointStates_ = 0;
@@ -274,42 +308,15 @@ TEST_F(Ros2IoBoardTest, TheServoCycleDoesNotAllocate) {
 // reads fail naming the arm; the amplifiers switched off send one empty command.
 TEST_F(Ros2IoBoardTest, TheBoardSendsTorquesOnlyWhileItsSamplesAreFresh) {
   const dds_entity_t efforts = reader(std_msgs_msg_dds__Float64MultiArray__desc, "arm/effort_commands");
-  auto rawWriter = [&](const dds_topic_descriptor_t& desc, const std::string& topic) {
-    const std::string name = "rt/" + ns_ + "/" + topic;
-    const dds_entity_t t = dds_create_topic(participant_, &desc, name.c_str(), nullptr, nullptr);
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-    const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
-    dds_delete_qos(qos);
-    EXPECT_GT(w, 0) << name;
-    return w;
-  };
-  const dds_entity_t joints = rawWriter(sensor_msgs_msg_dds__JointState__desc, "joint_states");
-  const dds_entity_t state = rawWriter(std_msgs_msg_dds__String__desc, "arm/state");
+  const dds_entity_t joints = writer(sensor_msgs_msg_dds__JointState__desc, "joint_states");
+  const dds_entity_t state = writer(std_msgs_msg_dds__String__desc, "arm/state");
   std::atomic<bool> publishing{true}, stop{false};
   std::thread remote([&] {  // the remote arm at 1 kHz: joint1 at 0.5 rad; its state each 50 ms
     int k = 0;
     while (!stop.load()) {
-      if (publishing.load()) {
-        sensor_msgs_msg_dds__JointState_ js{};
-        const auto now = std::chrono::system_clock::now().time_since_epoch();
-        js.header.stamp.sec = static_cast<int32_t>(std::chrono::duration_cast<std::chrono::seconds>(now).count());
-        js.header.stamp.nanosec = static_cast<uint32_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count() % 1000000000);
-        js.header.frame_id = const_cast<char*>("");
-        char name[] = "arm_joint1";
-        char* names[] = {name};
-        double q[] = {0.5}, zero[] = {0.0};
-        js.name = {1, 1, names, false};
-        js.position = {1, 1, q, false};
-        js.velocity = {1, 1, zero, false};
-        js.effort = {1, 1, zero, false};
-        dds_write(joints, &js);
-      }
-      if (k++ % 50 == 0) {
-        std_msgs_msg_dds__String_ s{};
-        s.data = const_cast<char*>(R"({"power":true,"errorCode":0,"shutdown":false,"effortsRefused":0})");
-        dds_write(state, &s);
-      }
+      if (publishing.load())
+        writeJoint(joints, std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count(), 0.5);
+      if (k++ % 50 == 0) writePowerOn(state);
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   });
@@ -395,6 +402,69 @@ TEST_F(Ros2IoBoardTest, TheBoardSendsTorquesOnlyWhileItsSamplesAreFresh) {
   const Ros2IoBoardStatistics st = board.getStatistics();
   EXPECT_GT(st.samples, 100u);
   EXPECT_EQ(st.writeFailures, 0u);
+}
+
+// A sample that comes again under the same stamp (a bridge publishing an arm's hardware sample
+// that its server has not renewed yet) is the same sample: no new sample for the servo loop
+// (DefaultManipulator keeps position and velocity), and the next new sample's time step is the
+// whole time since the last. (Before, a repeated stamp counted as one cycle later: the joints
+// read as standing still for a cycle, then moving twice as fast.) Sample times are on this
+// machine's CLOCK_MONOTONIC, as IoBoard::inputSampleTime() says (they were the remote's stamps).
+TEST_F(Ros2IoBoardTest, ASampleRepeatedUnderItsStampIsOneSample) {
+  (void)reader(std_msgs_msg_dds__Float64MultiArray__desc, "arm/effort_commands");  // the domain on loopback, as the board's
+  const dds_entity_t joints = writer(sensor_msgs_msg_dds__JointState__desc, "joint_states");
+  const dds_entity_t state = writer(std_msgs_msg_dds__String__desc, "arm/state");
+  const std::int64_t t0 = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  std::atomic<bool> stop{false};
+  std::atomic<std::int64_t> last{t0};
+  std::thread remote([&] {  // until the board is connected: samples 1 ms apart, and the state
+    for (int k = 1; !stop.load(); ++k) {
+      writeJoint(joints, t0 + k * 1000000, 0.5);
+      last = t0 + k * 1000000;
+      if (k % 50 == 1) writePowerOn(state);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  Ros2IoBoardOptions o;
+  o.remote = ns_ + "/arm";
+  o.domain = options_.domain;
+  o.connectTimeout = 30;
+  std::unique_ptr<Ros2IoBoard> board;
+  try {
+    board = std::make_unique<Ros2IoBoard>(o, std::vector<std::string>{"joint1"}, std::vector<double>{2.0});
+  } catch (...) {
+    stop = true;
+    remote.join();
+    throw;
+  }
+  stop = true;
+  remote.join();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the last of those in
+  const std::uint64_t samplesBefore = board->getStatistics().samples;
+  // One sample at a time, each waited for.
+  auto send = [&](std::int64_t stamp, double q) {
+    const std::uint64_t before = board->getStatistics().samples;
+    writeJoint(joints, stamp, q);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    while (board->getStatistics().samples == before && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    EXPECT_GT(board->getStatistics().samples, before) << "the sample stamped " << stamp << " did not come";
+    std::int64_t counts = 0;
+    EXPECT_EQ(board->readEncoder(0, counts), IoStatus::kOk) << board->lastError();
+    return std::make_pair(board->inputSampleTime(), counts);
+  };
+  const std::int64_t s = last.load();
+  const auto a = send(s + 1000000, 0.501);
+  // On this machine's CLOCK_MONOTONIC (the IoBoard contract), near when it came.
+  const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  EXPECT_LE(a.first, now);
+  EXPECT_GT(a.first, now - 10000000000) << "not a time on this machine's monotonic clock";
+  writeJoint(joints, s + 1000000, 0.501);   // the same sample again: not counted, no time of its own
+  const auto c = send(s + 3000000, 0.503);  // two cycles on (it follows the repeat: one writer, in order)
+  EXPECT_EQ(a.second, 501000000);
+  EXPECT_EQ(c.first - a.first, 2000000) << "the step to the next new sample is not the time between their stamps";
+  EXPECT_EQ(c.second, 503000000);
+  EXPECT_EQ(board->getStatistics().samples - samplesBefore, 2u) << "the repeated sample counted as a new one";
 }
 
 TEST_F(Ros2IoBoardTest, SettingsErrorsNameTheFileAndLine) {

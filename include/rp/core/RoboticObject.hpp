@@ -54,8 +54,8 @@ inline constexpr int kMaxStateValues = 128;
 /// read by the GUI (see TripleBuffer). Trivially copyable.
 struct StateSnapshot {
   double time = 0;           ///< clock time of the cycle that published it [s]
-  /// Clock time its inputs (the arm's joints) hold for [s]: read from hardware, when the cycle read
-  /// them, later than `time` (the scheduled time) by the wake-up latency and the work before; of a
+  /// Clock time its inputs (the arm's joints) hold for [s]: from hardware, when the cycle read them
+  /// (from a hardware server, when it sampled them: a sample read again keeps its time); of a
   /// simulation (its state integrated to `time`) or on a simulated clock, `time`; 0 if not said.
   double readTime = 0;
   std::uint64_t cycle = 0;   ///< cycle number

@@ -50,8 +50,8 @@ struct Ros2IoBoardStatistics {
 /// | digital output 0 (amplifiers on) | effort commands are written while it is on and the last sample is at most 10 ms old; when it goes off, or the samples go stale (and when the board goes while on), one empty command lets go of the arm, which the remote bridge then holds, and none is written after it until both hold again |
 ///
 /// Samples arrive in Cyclone DDS's receive thread (a listener) and reach the servo loop through a
-/// sequence lock: inputSampleTime() is the remote servo cycle's stamp, so the manipulator
-/// differentiates positions over the remote arm's own cycle times. The outputs of a cycle are
+/// sequence lock: inputSampleTime() steps by the remote servo cycles' stamps, so the manipulator
+/// differentiates positions over the remote arm's own cycle times (a stamp repeated: no new sample). The outputs of a cycle are
 /// written by a thread of the board's own, woken as the cycle ends: the servo thread makes no DDS
 /// call and does not allocate.
 ///
@@ -113,8 +113,8 @@ class Ros2IoBoard : public IoBoard {
   /// Joint `encoder`'s position in the last joint_states sample [counts]; fails as the class
   /// comment says. Real-time safe: yes.
   IoStatus readEncoder(int encoder, std::int64_t& counts) noexcept override;
-  /// The stamp of the sample the reads return (the remote servo cycle's wall-clock time) [ns];
-  /// -1 while a new sample is being stored. Real-time safe: yes.
+  /// When the sample the reads return was taken, on CLOCK_MONOTONIC [ns]: its stamp (the remote
+  /// cycle's) moved by the first sample's receipt; -1 while one is stored. Real-time safe: yes.
   std::int64_t inputSampleTime() const noexcept override;
 
  private:
