@@ -956,22 +956,9 @@ TEST_F(ManipulatorTest, TheStateSnapshotOfASimulatedArmHoldsAtItsCyclesTime) {
   }
   RoboticPlatform::useRealClock();
   {
-    // Cycles made late on purpose: the servo control stalls the loop for 5 ms now and then.
-    class Stalling : public ServoControl {
-     public:
-      explicit Stalling(ServoControl& inner) : ServoControl("stalling"), inner_(inner) {}
-      ~Stalling() override { releaseFromManipulator(); }
-      void calculate() override {
-        if (++calls_ % 50 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        inner_.calculate();
-      }
-
-     private:
-      ServoControl& inner_;
-      int calls_ = 0;
-    };
+    // Cycles made late on purpose: the servo control stalls the loop for 5 ms every 50 cycles.
     Puma560 puma("puma");
-    Stalling stalling(puma.getDefaultPositionControl());
+    test::StallingControl stalling(puma.getDefaultPositionControl(), 50, 50, std::chrono::milliseconds(5));
     puma.setServoControl(stalling);
     ASSERT_TRUE(puma.waitForCycles(3));
     const Clock& clock = puma.getControlProgram()->getClock();

@@ -49,7 +49,18 @@ test::ChildProcess startServer(const std::string& prefix) {
   return test::ChildProcess({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
 }
 
-TEST(HardwareManipulator, PumaBehindAHardwareServerHoldsMovesAndShutsDownWhenTheServerDies) {
+// Each test ends as the suite began, however it ends (a failed ASSERT too): simulation mode on,
+// the simulated clock, no shutdown pending.
+class HardwareManipulator : public ::testing::Test {
+ protected:
+  void TearDown() override {
+    RoboticPlatform::setSimulationModeOn();
+    RoboticPlatform::useSimulatedClock();
+    ObjectManager::resetShutdown();
+  }
+};
+
+TEST_F(HardwareManipulator, PumaBehindAHardwareServerHoldsMovesAndShutsDownWhenTheServerDies) {
   test::ChildProcess server = startServer("test-arm");
   ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
   {
@@ -80,27 +91,9 @@ TEST(HardwareManipulator, PumaBehindAHardwareServerHoldsMovesAndShutsDownWhenThe
     EXPECT_NE(puma.getErrorStatus().message.find("hardware failure"), std::string::npos)
         << puma.getErrorStatus().message;
   }
-  RoboticPlatform::setSimulationModeOn();
-  RoboticPlatform::useSimulatedClock();
-  ObjectManager::resetShutdown();
 }
 
-// Delegates to the default control and stalls the servo thread once, as a busy machine may.
-class StallOnce : public ServoControl {
- public:
-  explicit StallOnce(DefaultPositionControl& inner) : inner_(inner) {}
-  ~StallOnce() override { releaseFromManipulator(); }
-  void calculate() override {
-    if (++calls == 300) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    inner_.calculate();
-  }
-  std::atomic<int> calls{0};
-
- private:
-  DefaultPositionControl& inner_;
-};
-
-TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
+TEST_F(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
   // 100 ms without a cycle while joint 1 moves at 0.5 rad/s: the encoders moved 0.05 rad, which
   // divided by one period (1 ms) read as 50 rad/s and tripped the 2 rad/s velocity limit. The
   // velocity is taken over the time that really passed.
@@ -108,7 +101,7 @@ TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
   ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
   {
     Puma560 puma("leader");
-    StallOnce stall(puma.getDefaultPositionControl());
+    test::StallingControl stall(puma.getDefaultPositionControl(), 300, 0, std::chrono::milliseconds(100));  // cycle 300: 100 ms
     test::JointRamp ramp(0, 0.5, 1.0);  // joint 1 at 0.5 rad/s for 1 s
     puma.setServoControl(stall);
     puma.setTrajectoryGenerator(ramp);
@@ -119,16 +112,13 @@ TEST(HardwareManipulator, AStalledCycleIsNoVelocitySpike) {
     EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
     puma.clearTrajectoryGenerator();
   }
-  RoboticPlatform::setSimulationModeOn();
-  RoboticPlatform::useSimulatedClock();
-  ObjectManager::resetShutdown();
 }
 
 // A Puma held still behind the server dithers by an encoder count now and then (5e-5 rad), which
 // the velocity filter shows as pulses of up to 0.0072 rad/s a count. Still is at rest all the same:
 // leaving the hardware is accepted, and a shutdown's hold powers the arm off once it has been still
 // for 50 ms, not at the hold's 3 s timeout. (Both asked for less than the pulse of one count.)
-TEST(HardwareManipulator, AnArmHeldStillIsAtRestWhateverItsEncodersDither) {
+TEST_F(HardwareManipulator, AnArmHeldStillIsAtRestWhateverItsEncodersDither) {
   test::ChildProcess server = startServer("test-rest");
   ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
   double holdSeconds = 0;
@@ -160,9 +150,6 @@ TEST(HardwareManipulator, AnArmHeldStillIsAtRestWhateverItsEncodersDither) {
     holdSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   EXPECT_LT(holdSeconds, 1.0) << "the hold waited for a rest that encoder dither never gave";
-  RoboticPlatform::setSimulationModeOn();
-  RoboticPlatform::useSimulatedClock();
-  ObjectManager::resetShutdown();
 }
 
 // StateSnapshot::readTime of an arm behind hardware, which the ROS 2 bridge stamps joint states
@@ -174,7 +161,7 @@ TEST(HardwareManipulator, AnArmHeldStillIsAtRestWhateverItsEncodersDither) {
 // server is stopped, the cycles go on reading its last sample: they keep that sample's time. (With
 // the time of each read instead, old joints went out under new stamps: to a reader differentiating
 // over them, as a program driving the arm over ROS 2 does, a velocity dip and then a spike.)
-TEST(HardwareManipulator, TheStateSnapshotHoldsForTheServersSample) {
+TEST_F(HardwareManipulator, TheStateSnapshotHoldsForTheServersSample) {
   test::ChildProcess server = startServer("test-read");
   ASSERT_TRUE(server.readLine(30000).has_value()) << "the server did not start";
   {
@@ -233,17 +220,13 @@ TEST(HardwareManipulator, TheStateSnapshotHoldsForTheServersSample) {
     EXPECT_GT(resumed.readTime, last);
     EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
   }
-  RoboticPlatform::setSimulationModeOn();
-  RoboticPlatform::useSimulatedClock();
-  ObjectManager::resetShutdown();
 }
 
-TEST(HardwareManipulator, AnAbsentServerIsAClearError) {
+TEST_F(HardwareManipulator, AnAbsentServerIsAClearError) {
   RoboticPlatform::setConfiguration(Configuration::parse(
       "[leader]\nclass Puma560\nsimulationMode off\nhwserver no-such-server\n", "rp.cfg"));
   RoboticPlatform::setSimulationModeOff();
   EXPECT_THROW(Puma560("leader"), IoException);
-  RoboticPlatform::setSimulationModeOn();
 }
 
 }  // namespace

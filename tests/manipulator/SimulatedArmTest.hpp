@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <limits>
+#include <thread>
 
 #include "rp/RoboticPlatform.hpp"
 
@@ -53,6 +55,25 @@ class WrappedControl : public ServoControl {
 
  private:
   ServoControl& inner_;
+};
+
+// Wraps a servo control and stalls the servo thread in calculate(), as a busy machine may: for
+// `stall` in call `first`, then every `every` calls after it (0: only once). Counts its calls.
+class StallingControl : public WrappedControl {
+ public:
+  StallingControl(ServoControl& inner, int first, int every, std::chrono::milliseconds stall)
+      : WrappedControl(inner), first_(first), every_(every), stall_(stall) {}
+  ~StallingControl() override { release(); }
+  void calculate() override {
+    const int call = ++calls;
+    if (call == first_ || (every_ > 0 && call > first_ && (call - first_) % every_ == 0)) std::this_thread::sleep_for(stall_);
+    inner().calculate();
+  }
+  std::atomic<int> calls{0};
+
+ private:
+  const int first_, every_;
+  const std::chrono::milliseconds stall_;
 };
 
 // Outputs a constant torque on one joint (for the first `cycles` cycles if given, then the
