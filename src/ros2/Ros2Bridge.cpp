@@ -369,7 +369,7 @@ void Ros2Bridge::declareSettings(SettingSchema& schema) {
   RoboticObject::declareSettings(schema);
   schema.addInteger("domain", "DDS domain id (ROS_DOMAIN_ID)", 0, kMaxDomain);
   schema.addWord("namespace", "ROS namespace of the topics, e.g. cell1");
-  schema.addWord("rate", "joint_states and tf samples per second, 1 .. 1000 Hz, or servo: every servo cycle");
+  schema.addWord("rate", "joint_states and tf samples per second, 1 .. 1000 Hz, or servo: every servo cycle's new joints");
   ros2detail::addInterfacesSetting(schema);
   schema.setDefault("domain", "0");
   schema.setDefault("namespace", "(none)");

@@ -36,6 +36,7 @@ constexpr std::uint64_t kRateSamples = 20;  // samples that measure the remote r
 constexpr double kLongestSampleInterval = 0.005;  // [s] the slowest joint_states a torque loop takes
 constexpr std::int64_t kLongestStampStep = 1000000000;  // [ns] a longer step between stamps is a clock step
 constexpr double kStaleSample = 0.01;  // [s] torques computed from an older sample are not sent
+constexpr std::int64_t kOffsetSlew = 1000;  // [ns] the most the stamps' offset to this clock moves in a sample
 constexpr int kMaxWriteFailures = 10;             // effort commands that fail in a row before it is a fault
 
 // A bridge's refusal ("refused: why") without its prefix.
@@ -65,7 +66,8 @@ struct Ros2IoBoard::Impl {
   // the stored sample's time on CLOCK_MONOTONIC (its stamp plus stampToLocal) [ns], -1 while one
   // is stored, 0 before the first.
   std::atomic<std::int64_t> sampleTime{0};
-  std::int64_t stampToLocal = 0;  // the listener's own: the first sample's receipt minus its stamp [ns]
+  std::int64_t stampToLocal = 0;  // the listener's own: this clock minus the stamps [ns]
+  std::int64_t lowestSeen = 0;    // the listener's own: the least (receipt - stamp) of late [ns]
   std::array<std::atomic<std::int64_t>, kMaxJoints> counts{};
   std::atomic<std::int64_t> lastReceipt{0};  // steady clock [ns] of the last sample of the arm
   std::int64_t lastStamp = 0;                // the listener's own: the last sample time stored
@@ -141,24 +143,34 @@ struct Ros2IoBoard::Impl {
         // the remote arm's own cycle times (receipt times carry the network's jitter). Where a stamp
         // does not follow on (the remote wall clock stepped back, or ahead by more than a second),
         // the step is the last good one: one remote cycle. A stamp that comes again is the same
-        // sample again (an arm's hardware sample its server has not renewed yet): it keeps its
-        // time, so the reader sees no new sample rather than joints standing still for a cycle.
+        // sample again (an arm's hardware sample its server has not renewed yet): nothing new, so
+        // the reader sees no new sample rather than joints standing still for a cycle (and, the
+        // sample growing old, no torque is sent on it, and the silence becomes a fault).
         const std::int64_t remoteStamp = static_cast<std::int64_t>(js.header.stamp.sec) * 1000000000 + js.header.stamp.nanosec;
         std::int64_t step = remoteStamp - lastRemoteStamp;
-        if (step == 0 && lastStamp != 0) {  // (not counted in the samples: none new)
-          lastReceipt.store(steadyNanoseconds(), std::memory_order_release);
-          return;
-        }
+        if (step == 0 && lastStamp != 0) return;
         if (step < 0 || step > kLongestStampStep)
           step = goodStep;
         else
           goodStep = step;
         lastRemoteStamp = remoteStamp;
         const std::int64_t stamp = lastStamp == 0 ? std::max<std::int64_t>(remoteStamp, 1) : lastStamp + step;
-        // On this machine's CLOCK_MONOTONIC (IoBoard::inputSampleTime()), as received at the first
-        // sample: the steps stay the remote cycles' (two clocks' rates differ by some parts per
-        // million, so the times drift from the receipts by that much).
-        if (lastStamp == 0) stampToLocal = steadyNanoseconds() - stamp;
+        // On this machine's CLOCK_MONOTONIC (IoBoard::inputSampleTime()): the stamp plus an offset
+        // that follows the least delayed samples' receipt minus stamp (`lowestSeen`, which rises by
+        // the slew a sample so that it follows a remote clock slower than this one). The offset
+        // moves by at most kOffsetSlew (1 us) a sample, and less than half the step: a first
+        // sample that came late and the clocks' different rates (parts per million) are taken out
+        // while the steps stay the remote cycles' to 0.1 % of a 1 ms cycle, and never go back.
+        const std::int64_t seen = steadyNanoseconds() - stamp;
+        if (lastStamp == 0) {
+          stampToLocal = lowestSeen = seen;
+        } else if (samples.load(std::memory_order_relaxed) < kRateSamples) {
+          stampToLocal = lowestSeen = std::min(lowestSeen, seen);  // connecting: no reader yet, no slew
+        } else {
+          lowestSeen = std::min(lowestSeen + kOffsetSlew, seen);
+          const std::int64_t slew = std::min(kOffsetSlew, step / 2);
+          stampToLocal += std::clamp(lowestSeen - stampToLocal, -slew, slew);
+        }
         lastStamp = stamp;
         if (firstStamp.load(std::memory_order_relaxed) == 0) firstStamp.store(stamp);
         latestStamp.store(stamp);

@@ -3,11 +3,13 @@
 #include "rp/io/HwServer.hpp"
 
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
-#include <filesystem>
 #include <fstream>
 #include <cmath>
 #include <limits>
@@ -29,14 +31,14 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 // Unique per process and test, so that ctest -j runs do not collide.
 std::string uniqueName(const char* what) { return std::string("test-") + what + "-" + std::to_string(::getpid()); }
 
-// Whether the process at `proc` (its /proc directory) has a descriptor open on the file `path`.
-bool holdsFileNamed(const std::string& proc, const std::string& path) {
-  std::error_code ec;
-  for (std::filesystem::directory_iterator fd(proc + "/fd", ec), end; !ec && fd != end; fd.increment(ec)) {
-    std::error_code e;
-    if (std::filesystem::read_symlink(fd->path(), e) == path) return true;
-  }
-  return false;
+// Whether no process holds the lock of the server segment `name` (what HwServer::start() asks of a
+// segment it finds: a lock held is a living server).
+bool segmentUnlocked(const std::string& name) {
+  const int fd = ::shm_open(("/rp-hwserver-" + name).c_str(), O_RDONLY | O_CLOEXEC, 0);
+  if (fd < 0) return false;
+  const bool unlocked = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+  ::close(fd);  // (and the lock just taken with it)
+  return unlocked;
 }
 
 // These tests are not about the client watchdog (HwServerWatchdog_test is): a watchdog time long
@@ -156,13 +158,12 @@ TEST(HwServer, ASegmentLeftByADeadServerIsReplacedEvenIfItsPidLivesOn) {
   bool replaced = false;
   for (int i = 0; i < 1000; ++i) {  // bounded: 10 s
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    // The exec is over when the process is `sleep` and holds no descriptor of the segment (the
-    // kernel names the process before it closes the descriptors marked close-on-exec, which
-    // release the server's lock: waiting for the name alone once met the lock still held).
-    const std::string proc = "/proc/" + std::to_string(child);
-    std::ifstream comm(proc + "/comm");
+    // The exec is over when the process is `sleep` and the server's lock is free: the lock goes
+    // with the last reference to the segment's open file, which the exec drops at its own pace
+    // (waiting for the name alone once met the lock still held).
+    std::ifstream comm("/proc/" + std::to_string(child) + "/comm");
     std::string what;
-    if (!(comm >> what) || what != "sleep" || holdsFileNamed(proc, "/dev/shm/rp-hwserver-" + name)) continue;
+    if (!(comm >> what) || what != "sleep" || !segmentUnlocked(name)) continue;
     SimulatedIoBoard board;
     HwServer server(board, name, 100.0);
     EXPECT_NO_THROW(server.start()) << "the dead server's segment was not replaced";

@@ -49,11 +49,12 @@ test::ChildProcess startServer(const std::string& prefix) {
   return test::ChildProcess({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
 }
 
-// Each test ends as the suite began, however it ends (a failed ASSERT too): simulation mode on,
-// the simulated clock, no shutdown pending.
+// Each test ends as the suite began, however it ends (a failed ASSERT too): no configuration,
+// simulation mode on, the simulated clock, no shutdown pending.
 class HardwareManipulator : public ::testing::Test {
  protected:
   void TearDown() override {
+    RoboticPlatform::setConfiguration(Configuration());
     RoboticPlatform::setSimulationModeOn();
     RoboticPlatform::useSimulatedClock();
     ObjectManager::resetShutdown();
@@ -207,17 +208,18 @@ TEST_F(HardwareManipulator, TheStateSnapshotHoldsForTheServersSample) {
     }
     ASSERT_GT(lastNs, 0) << "the server stopped in the middle of storing a sample, five times";
     const double last = onArmsClock(lastNs);
-    const StateSnapshot first = nextCycle(s.time);
-    std::this_thread::sleep_for(std::chrono::milliseconds(30));
-    const StateSnapshot later = nextCycle(first.time);
+    const StateSnapshot first = nextCycle(clock->getTime());  // a cycle after the stop
+    const StateSnapshot later = nextCycle(first.time + 0.03);
     server.signal(SIGCONT);
     EXPECT_GE(later.cycle - first.cycle, 10u) << "the servo loop did not run while the server was stopped";
     EXPECT_NEAR(first.readTime, last, 1e-8);
     EXPECT_NEAR(later.readTime, last, 1e-8) << "a cycle reading the stopped server's sample again stamped it anew";
     for (int k = 0; k < 6; ++k) EXPECT_EQ(later.values[k], first.values[k]) << "joint " << k + 1;
     // Going again: new samples, new times.
-    const StateSnapshot resumed = nextCycle(later.time + 0.02);
-    EXPECT_GT(resumed.readTime, last);
+    StateSnapshot resumed = later;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    while (resumed.readTime <= last && std::chrono::steady_clock::now() < deadline) resumed = nextCycle(resumed.time);
+    EXPECT_GT(resumed.readTime, last) << "no new sample after the server went on";
     EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
   }
 }

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -454,10 +455,11 @@ class CycleRecorder : public ControlProgram {
 // that offset stays the same between the bridge's measurements of it (one a second). So the test
 // does not depend on how late the servo thread wakes (hundreds of microseconds under ASan with
 // other tests running).
-// Takes joint_states samples from `r` until `stamps` holds `count` stamps [ns] (at most 20 s).
+// Takes joint_states samples from `r` until `stamps` holds `count` stamps [ns] (at most 20 s; at
+// least one take).
 void takeStamps(dds_entity_t r, std::vector<std::int64_t>& stamps, std::size_t count) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (stamps.size() < count && std::chrono::steady_clock::now() < end) {
+  do {
     void* samples[10] = {nullptr};
     dds_sample_info_t info[10];
     const dds_return_t n = dds_take(r, samples, info, 10, 10);
@@ -468,7 +470,7 @@ void takeStamps(dds_entity_t r, std::vector<std::int64_t>& stamps, std::size_t c
     }
     if (n > 0) dds_return_loan(r, samples, n);
     std::this_thread::sleep_for(std::chrono::microseconds(500));
-  }
+  } while (stamps.size() < count && std::chrono::steady_clock::now() < end);
 }
 
 // An arm behind a hardware server (rp-hwserver's emulated Puma), published at the servo rate:
@@ -478,6 +480,10 @@ void takeStamps(dds_entity_t r, std::vector<std::int64_t>& stamps, std::size_t c
 // cycles' new stamps: to a reader differentiating over them, standing still, then a jump.)
 TEST_F(Ros2BridgeTest, AtTheServoRateEachHardwareSampleGoesOutOnceStampedWhenTaken) {
   const std::string name = "test-bridge-hw-" + std::to_string(::getpid());
+  struct Unlink {  // the segment of the server, which its SIGKILL at the end leaves behind
+    const std::string& name;
+    ~Unlink() { ::shm_unlink(("/rp-hwserver-" + name).c_str()); }
+  } unlink{name};
   Child server({RP_HWSERVER_PATH, "-name", name, "-rate", "1000", "-board", "puma560", "-watchdog", "5000"});
   ASSERT_TRUE(contains(server.line(), "serving")) << "the hardware server did not start";
   RoboticPlatform::setConfiguration(Configuration::parse("[puma]\nclass Puma560\nsimulationMode off\nhwserver " + name + "\n", "rp.cfg"));
@@ -497,8 +503,10 @@ TEST_F(Ros2BridgeTest, AtTheServoRateEachHardwareSampleGoesOutOnceStampedWhenTak
     Ros2Bridge bridge("ros", options_);
     const dds_entity_t r = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
     takeStamps(r, stamps, 100);
+    // 40 ms stopped, taking what comes meanwhile (the reader keeps only the last ten samples).
     ::kill(server.pid, SIGSTOP);
-    std::this_thread::sleep_for(std::chrono::milliseconds(40));
+    const auto resume = std::chrono::steady_clock::now() + std::chrono::milliseconds(40);
+    while (std::chrono::steady_clock::now() < resume) takeStamps(r, stamps, 0);
     ::kill(server.pid, SIGCONT);
     takeStamps(r, stamps, stamps.size() + 100);
     EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
@@ -509,8 +517,7 @@ TEST_F(Ros2BridgeTest, AtTheServoRateEachHardwareSampleGoesOutOnceStampedWhenTak
     EXPECT_GT(stamps[i], stamps[i - 1]) << "sample " << i << " went out again (or out of order)";
     longest = std::max(longest, stamps[i] - stamps[i - 1]);
   }
-  EXPECT_GE(longest, 30000000) << "no sample waited for the stopped server";
-  std::printf("%zu samples, the longest step between stamps %.1f ms\n", stamps.size(), 1e-6 * static_cast<double>(longest));
+  EXPECT_GE(longest, 35000000) << "no sample waited for the stopped server";
 }
 
 TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithItsTime) {

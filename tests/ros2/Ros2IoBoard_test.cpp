@@ -429,6 +429,7 @@ TEST_F(Ros2IoBoardTest, ASampleRepeatedUnderItsStampIsOneSample) {
   o.remote = ns_ + "/arm";
   o.domain = options_.domain;
   o.connectTimeout = 30;
+  o.timeout = 5;  // (a loaded machine's pauses between the samples below are no fault)
   std::unique_ptr<Ros2IoBoard> board;
   try {
     board = std::make_unique<Ros2IoBoard>(o, std::vector<std::string>{"joint1"}, std::vector<double>{2.0});
@@ -439,8 +440,13 @@ TEST_F(Ros2IoBoardTest, ASampleRepeatedUnderItsStampIsOneSample) {
   }
   stop = true;
   remote.join();
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the last of those in
-  const std::uint64_t samplesBefore = board->getStatistics().samples;
+  std::uint64_t samplesBefore = board->getStatistics().samples;  // once the last of those is in
+  for (int i = 0; i < 100; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const std::uint64_t now = board->getStatistics().samples;
+    if (now == samplesBefore) break;
+    samplesBefore = now;
+  }
   // One sample at a time, each waited for.
   auto send = [&](std::int64_t stamp, double q) {
     const std::uint64_t before = board->getStatistics().samples;
@@ -462,9 +468,53 @@ TEST_F(Ros2IoBoardTest, ASampleRepeatedUnderItsStampIsOneSample) {
   writeJoint(joints, s + 1000000, 0.501);   // the same sample again: not counted, no time of its own
   const auto c = send(s + 3000000, 0.503);  // two cycles on (it follows the repeat: one writer, in order)
   EXPECT_EQ(a.second, 501000000);
-  EXPECT_EQ(c.first - a.first, 2000000) << "the step to the next new sample is not the time between their stamps";
+  // (The offset to this clock moves by at most 1 us a sample.)
+  EXPECT_NEAR(c.first - a.first, 2000000, 1000) << "the step to the next new sample is not the time between their stamps";
   EXPECT_EQ(c.second, 503000000);
   EXPECT_EQ(board->getStatistics().samples - samplesBefore, 2u) << "the repeated sample counted as a new one";
+}
+
+// The sample times are this machine's CLOCK_MONOTONIC at the least delayed samples' receipt, not
+// at the first sample's: a first sample that came 30 ms late (a resend after discovery) does not
+// put every later sample 30 ms in the future.
+TEST_F(Ros2IoBoardTest, ALateFirstSampleDoesNotShiftTheSampleTimes) {
+  (void)reader(std_msgs_msg_dds__Float64MultiArray__desc, "arm/effort_commands");  // the domain on loopback, as the board's
+  const dds_entity_t joints = writer(sensor_msgs_msg_dds__JointState__desc, "joint_states");
+  const dds_entity_t state = writer(std_msgs_msg_dds__String__desc, "arm/state");
+  auto wallNow = [] {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  };
+  std::atomic<bool> stop{false};
+  std::thread remote([&] {  // once the board reads: samples stamped when written, the first 30 ms before
+    dds_publication_matched_status_t matched{};
+    while (!stop.load() && (dds_get_publication_matched_status(joints, &matched) != 0 || matched.current_count == 0)) {
+      writePowerOn(state);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    for (int k = 0; !stop.load(); ++k) {
+      writeJoint(joints, wallNow() - (k == 0 ? 30000000 : 0), 0.5);
+      if (k % 50 == 0) writePowerOn(state);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  struct Join {
+    std::atomic<bool>& stop;
+    std::thread& thread;
+    ~Join() {
+      stop = true;
+      thread.join();
+    }
+  } join{stop, remote};
+  Ros2IoBoardOptions o;
+  o.remote = ns_ + "/arm";
+  o.domain = options_.domain;
+  o.connectTimeout = 30;
+  Ros2IoBoard board(o, {"joint1"}, {2.0});
+  std::int64_t t = board.inputSampleTime();
+  for (int i = 0; i < 1000 && t < 0; ++i) t = board.inputSampleTime();
+  const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  EXPECT_LE(t, now + 1000000) << "the latest sample " << 1e-6 * static_cast<double>(t - now) << " ms in the future";
+  EXPECT_GT(t, now - 100000000) << "the latest sample " << 1e-6 * static_cast<double>(now - t) << " ms old";
 }
 
 TEST_F(Ros2IoBoardTest, SettingsErrorsNameTheFileAndLine) {

@@ -55,8 +55,8 @@ inline constexpr int kMaxStateValues = 128;
 struct StateSnapshot {
   double time = 0;           ///< clock time of the cycle that published it [s]
   /// Clock time its inputs (the arm's joints) hold for [s]: from hardware, when the cycle read them
-  /// (from a hardware server, when it sampled them: a sample read again keeps its time); of a
-  /// simulation (its state integrated to `time`) or on a simulated clock, `time`; 0 if not said.
+  /// (from a board that samples on its own: when it sampled them; a sample read again keeps its
+  /// time); of a simulation (integrated to `time`) or on a simulated clock, `time`; 0 if not said.
   double readTime = 0;
   std::uint64_t cycle = 0;   ///< cycle number
   int size = 0;              ///< number of valid entries in `values`

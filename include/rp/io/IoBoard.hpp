@@ -98,8 +98,8 @@ class IoBoard {
   /// of its own (a hardware server reads its board once per server cycle): CLOCK_MONOTONIC [ns].
   /// Two calls that return the same time bracket reads of one sample; a reader that differentiates
   /// positions divides by the time between samples, and knows a repeated sample for one.
-  /// @return the sample time [ns]; 0 if the inputs are sampled when read (every board but
-  ///         `HwServerIoBoard`); -1 while a new sample is being stored (read again)
+  /// @return the sample time [ns]; 0 if the inputs are sampled when read (all but
+  ///         `HwServerIoBoard` and `Ros2IoBoard`); -1 while a new sample is being stored (read again)
   /// Real-time safe: yes.
   virtual std::int64_t inputSampleTime() const noexcept { return 0; }
 

@@ -93,10 +93,12 @@ struct Ros2BridgeStatistics {
 /// threads publish (as the Scene Viewer does): a servo loop never waits for the bridge or the
 /// network. With `rate servo` (Ros2BridgeOptions::kServoRate) the thread wakes whenever a servo
 /// cycle ends (an executor's cycle, through a futex the loop only signals) and publishes each arm
-/// whose snapshot is new: every servo cycle of every arm, as soon as it ends; the state topics and
-/// the trajectories taken are then looked at 50 times a second. Stamps are the wall-clock time of
-/// the servo cycle that read the joints (on the real clock; on a simulated clock, the time of
-/// publication). Arms created after the bridge are published from the next cycle on.
+/// whose snapshot holds new joints: every servo cycle of every arm, as soon as it ends, but for a
+/// cycle that read a hardware server's sample again (not published again); the state topics and
+/// the trajectories taken are then looked at 50 times a second. Stamps are the wall-clock time the
+/// joints hold for (StateSnapshot::readTime: when the cycle read them, or the server sampled them;
+/// on a simulated clock, the time of publication). Arms created after the bridge are published
+/// from the next cycle on.
 ///
 /// rp.cfg (`[ros]` + `class Ros2Bridge`):
 /// | setting | meaning |

@@ -51,7 +51,8 @@ struct Ros2IoBoardStatistics {
 ///
 /// Samples arrive in Cyclone DDS's receive thread (a listener) and reach the servo loop through a
 /// sequence lock: inputSampleTime() steps by the remote servo cycles' stamps, so the manipulator
-/// differentiates positions over the remote arm's own cycle times (a stamp repeated: no new sample). The outputs of a cycle are
+/// differentiates positions over the remote arm's own cycle times (a stamp repeated: no new sample,
+/// and not fresh: no torque is sent on it, and a remote that only repeats one falls silent). The outputs of a cycle are
 /// written by a thread of the board's own, woken as the cycle ends: the servo thread makes no DDS
 /// call and does not allocate.
 ///
@@ -114,7 +115,8 @@ class Ros2IoBoard : public IoBoard {
   /// comment says. Real-time safe: yes.
   IoStatus readEncoder(int encoder, std::int64_t& counts) noexcept override;
   /// When the sample the reads return was taken, on CLOCK_MONOTONIC [ns]: its stamp (the remote
-  /// cycle's) moved by the first sample's receipt; -1 while one is stored. Real-time safe: yes.
+  /// cycle's) plus an offset that follows the least delayed receipts, slewed by at most 1 us a
+  /// sample (steps are the stamps' to that); -1 while one is stored. Real-time safe: yes.
   std::int64_t inputSampleTime() const noexcept override;
 
  private:
