@@ -28,6 +28,16 @@
 namespace rp::test {
 namespace {
 
+// Sets `stop` and joins `thread` when the scope ends, however it ends.
+struct StopAndJoin {
+  std::atomic<bool>& stop;
+  std::thread& thread;
+  ~StopAndJoin() {
+    stop = true;
+    thread.join();
+  }
+};
+
 class Ros2IoBoardTest : public Ros2Fixture {
  protected:
   void SetUp() override {
@@ -320,14 +330,7 @@ TEST_F(Ros2IoBoardTest, TheBoardSendsTorquesOnlyWhileItsSamplesAreFresh) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   });
-  struct Join {
-    std::atomic<bool>& stop;
-    std::thread& thread;
-    ~Join() {
-      stop = true;
-      thread.join();
-    }
-  } join{stop, remote};
+  StopAndJoin join{stop, remote};
   // The lengths of the effort commands received since the last call, in order.
   auto received = [&] {
     std::vector<uint32_t> lengths;
@@ -497,14 +500,7 @@ TEST_F(Ros2IoBoardTest, ALateFirstSampleDoesNotShiftTheSampleTimes) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   });
-  struct Join {
-    std::atomic<bool>& stop;
-    std::thread& thread;
-    ~Join() {
-      stop = true;
-      thread.join();
-    }
-  } join{stop, remote};
+  StopAndJoin join{stop, remote};
   Ros2IoBoardOptions o;
   o.remote = ns_ + "/arm";
   o.domain = options_.domain;
