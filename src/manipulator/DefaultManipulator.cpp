@@ -842,9 +842,9 @@ void DefaultManipulator::exitControl() {
 void DefaultManipulator::readInputs() {
   const double t = getTime();
   // When the joints are read (StateSnapshot::readTime): a clock read, no system call (vDSO), for
-  // hardware (a hardware server's sample time instead, below). A simulated arm's joints are its state at the cycle's time t, however late the cycle
-  // runs (a late cycle integrates to t, below, and a cycle after skipped deadlines catches up to
-  // its t): stamped with the clock instead, a late sample and the next would carry times that do
+  // hardware (a hardware server's sample time instead, below). A simulated arm's joints are its
+  // state at the cycle's time t, however late the cycle runs (a late cycle integrates to t, below,
+  // and a cycle after skipped deadlines catches up to its t): stamped with the clock instead, a late sample and the next would carry times that do
   // not match their motion, and a reader differentiating over the stamps (a program driving this
   // arm by torque over ROS 2) would see a velocity spike of 40 % at 1.6 rad/s after a 3 ms stall.
   readTime_ = getClock().isSimulated() || !board_ ? t : getClock().getTime();

@@ -52,8 +52,8 @@ struct Ros2IoBoardStatistics {
 /// Samples arrive in Cyclone DDS's receive thread (a listener) and reach the servo loop through a
 /// sequence lock: inputSampleTime() steps by the remote servo cycles' stamps, so the manipulator
 /// differentiates positions over the remote arm's own cycle times (a stamp repeated: no new sample,
-/// and not fresh: no torque is sent on it, and a remote that only repeats one falls silent). The outputs of a cycle are
-/// written by a thread of the board's own, woken as the cycle ends: the servo thread makes no DDS
+/// and not fresh: no torque is sent on it, and a remote that only repeats one falls silent). The
+/// outputs of a cycle are written by a thread of the board's own, woken as the cycle ends: the servo thread makes no DDS
 /// call and does not allocate.
 ///
 /// Faults: a read fails (and the manipulator shuts down, naming the board's message) when no
