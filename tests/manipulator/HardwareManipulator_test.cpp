@@ -153,12 +153,9 @@ TEST_F(HardwareManipulator, AnArmHeldStillIsAtRestWhateverItsEncodersDither) {
   EXPECT_LT(holdSeconds, 1.0) << "the hold waited for a rest that encoder dither never gave";
 }
 
-// StateSnapshot::readTime of an arm behind hardware, which the ROS 2 bridge stamps joint states
-// with: on the real clock, when the cycle read the encoders, after the cycle's scheduled time and
-// never later than the moment the snapshot is taken. (A simulated arm's is the cycle's time:
-// DefaultManipulator_test.)
-// The state snapshot of an arm behind a hardware server holds for the server's sample (its
-// CLOCK_MONOTONIC stamp, on the arm's clock), as another client of the server reads it. While the
+// StateSnapshot::readTime (the ROS 2 bridge's stamps) of an arm behind a hardware server: the
+// server's sample (its CLOCK_MONOTONIC stamp, on the arm's clock), as another client of the
+// server reads it; a simulated arm's is its cycle's time (DefaultManipulator_test). While the
 // server is stopped, the cycles go on reading its last sample: they keep that sample's time. (With
 // the time of each read instead, old joints went out under new stamps: to a reader differentiating
 // over them, as a program driving the arm over ROS 2 does, a velocity dip and then a spike.)
