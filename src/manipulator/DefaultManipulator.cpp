@@ -898,8 +898,9 @@ void DefaultManipulator::readInputs() {
       // sample's time, not for this read. A cycle that finds no new sample (the server late)
       // keeps the joints and their time: a new stamp on old joints would be a velocity dip to a
       // reader differentiating over the stamps, and the next sample a spike.
-      if (const auto* real = dynamic_cast<const RealClock*>(&getClock()))
-        readTime_ = 1e-9 * static_cast<double>(lastSampleTime_ - real->epochNanoseconds());
+      // (The real clock is one object: a pointer comparison, no dynamic_cast in the cycle.)
+      if (const RealClock& real = RealClock::instance(); &getClock() == &real)
+        readTime_ = 1e-9 * static_cast<double>(lastSampleTime_ - real.epochNanoseconds());
     }
   } else {
     // On the real clock a cycle delayed by a busy machine skips deadlines; the arm moved on under

@@ -434,15 +434,10 @@ TEST_F(Ros2IoBoardTest, ASampleRepeatedUnderItsStampIsOneSample) {
   o.connectTimeout = 30;
   o.timeout = 5;  // (a loaded machine's pauses between the samples below are no fault)
   std::unique_ptr<Ros2IoBoard> board;
-  try {
+  {
+    StopAndJoin join{stop, remote};  // (a throwing constructor too)
     board = std::make_unique<Ros2IoBoard>(o, std::vector<std::string>{"joint1"}, std::vector<double>{2.0});
-  } catch (...) {
-    stop = true;
-    remote.join();
-    throw;
   }
-  stop = true;
-  remote.join();
   std::uint64_t samplesBefore = board->getStatistics().samples;  // once the last of those is in
   for (int i = 0; i < 100; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
