@@ -22,6 +22,7 @@
 #include "rp/core/Core.hpp"
 #include "rp/gui/SceneViewer.hpp"
 #include "rp/manipulator/Manipulators.hpp"
+#include "../common/JsonInteger.hpp"
 #include "ChooseManipulator.hpp"
 
 namespace {
@@ -114,6 +115,8 @@ class JointFollower : public rp::TrajectoryGenerator {
       if (!j.is_object() || !j.contains("joint") || !j["joint"].is_number_integer() || !j.contains("value") ||
           !j["value"].is_number())
         throw std::invalid_argument("setJoint needs {\"joint\": index, \"value\": radians}");
+      if (!rp::apps::integerIn(j["joint"], 0, n_ - 1))
+        throw std::invalid_argument("setJoint: 'joint' must be an integer in 0.." + std::to_string(n_ - 1));
       set.emplace_back(j["joint"].get<int>(), j["value"].get<double>());
     } else {
       if (!j.is_array() || static_cast<int>(j.size()) != n_)

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "../common/JsonInteger.hpp"
 #include "ChooseManipulator.hpp"
 #include "rp/core/Core.hpp"
 #include "rp/gui/SceneViewer.hpp"
@@ -36,9 +37,10 @@ using nlohmann::json;
 // thread calls it: no allocation, no lock.
 class Brake : public rp::TrajectoryGenerator {
  public:
+  // name: the object's (unique: the last Stop's brake still exists while the next one is built);
   // velocity: the joints' velocity when the brake takes over [rad/s]
-  Brake(const rp::ManipulatorModel& model, const rp::JointVector& velocity)
-      : rp::TrajectoryGenerator("teachpendant.brake"), n_(model.getNumberOfJoints()) {
+  Brake(const std::string& name, const rp::ManipulatorModel& model, const rp::JointVector& velocity)
+      : rp::TrajectoryGenerator(name), n_(model.getNumberOfJoints()) {
     for (int i = 0; i < n_; ++i) {
       a_[static_cast<std::size_t>(i)] = 0.8 * model.getAccelerationLimit()(i);
       v_[static_cast<std::size_t>(i)] = velocity(i);
@@ -135,7 +137,7 @@ class Teachpendant : public rp::RoboticObject {
       for (int i = 0; i < 3; ++i) {
         const json& f = j["force"][static_cast<std::size_t>(i)];
         if (!f.is_number() || !std::isfinite(f.get<double>()) || std::abs(f.get<double>()) > kMaxForce)
-          throw std::invalid_argument("push: each force component must be a number within +-" + std::to_string(kMaxForce) + " N");
+          throw std::invalid_argument("push: each force component must be a number within +-" + std::to_string(static_cast<int>(kMaxForce)) + " N");
         wrench(i) = f.get<double>();
       }
       // The force holds for kPushLapse only: the page repeats it every 50 ms while the pointer
@@ -173,6 +175,8 @@ class Teachpendant : public rp::RoboticObject {
         std::lock_guard<std::mutex> lock(mutex_);
         if (j.is_object() && j.contains("indices")) {
           if (!j["indices"].is_array()) throw std::invalid_argument("cycle: 'indices' must be an array");
+          if (j["indices"].size() > kMaxCycleIndices)
+            throw std::invalid_argument("cycle: 'indices' must list at most " + std::to_string(kMaxCycleIndices) + " positions");
           for (const json& k : j["indices"]) which.push_back(index(json{{"index", k}}));
         }
         if (which.empty())
@@ -180,8 +184,7 @@ class Teachpendant : public rp::RoboticObject {
         if (which.empty()) throw std::invalid_argument("cycle: no stored positions");
       }
       if (j.is_object() && j.contains("times")) {
-        if (!j["times"].is_number_integer() || j["times"].get<int>() < 1 || j["times"].get<int>() > 100)
-          throw std::invalid_argument("cycle: 'times' must be 1 to 100");
+        if (!rp::apps::integerIn(j["times"], 1, 100)) throw std::invalid_argument("cycle: 'times' must be 1 to 100");
         times = j["times"].get<int>();
       }
       start(which, times);
@@ -193,7 +196,10 @@ class Teachpendant : public rp::RoboticObject {
         // The reply says where and how fast the arm was when the brake took over, and how hard
         // each joint brakes: the page's own state frame may be a frame or more old by then.
         const rp::JointVector q = arm_.getJointPosition(), qd = arm_.getJointVelocity();
-        auto brake = std::make_unique<Brake>(arm_.getModel(), qd);
+        // A name of its own: the last Stop's brake is released only after the arm has taken
+        // this one (built under one fixed name, every Stop after the first was refused, "an
+        // object named 'teachpendant.brake' already exists", and the motion went on).
+        auto brake = std::make_unique<Brake>("teachpendant.brake" + std::to_string(++brakes_), arm_.getModel(), qd);
         arm_.setTrajectoryGenerator(*brake);
         brake_ = std::move(brake);  // the previous brake, if any, after the arm left it
         json from = {{"q", json::array()}, {"qd", json::array()}, {"deceleration", json::array()}};
@@ -218,7 +224,10 @@ class Teachpendant : public rp::RoboticObject {
     std::string name;
     rp::JointVector q;
   };
-  static constexpr double kMaxForce = 500;  // [N]
+  // [N] per component: the page pulls with at most 60 N (web/src/teachpendant.js), enough to move
+  // the arm by hand; another client may not push harder.
+  static constexpr double kMaxForce = 60;
+  static constexpr std::size_t kMaxCycleIndices = 1000;  // as many as the list holds
   static constexpr std::chrono::milliseconds kPushLapse{250};  // a push not repeated within this ends
 
   // Thread: zeroes the push force once it has not been repeated for kPushLapse.
@@ -317,6 +326,7 @@ class Teachpendant : public rp::RoboticObject {
   std::string target_;
   std::unique_ptr<rp::DefaultTrajectoryGenerator<>> generator_;
   std::unique_ptr<Brake> brake_;  // the last Stop's brake (the arm may still use it)
+  int brakes_ = 0;                // Stops so far (each brake's name)
   std::thread job_;
   std::atomic<bool> running_{false}, abort_{false};
   // The push force's deadline (watchPush()).

@@ -119,7 +119,16 @@ std::vector<std::string> RoboticPlatform::parseCommandLine(const std::vector<std
     else if (a == "-config") setConfigurationFileName(value("a file name"));
     else if (a == "-log") setLogFileName(value("a CSV file name"));
     else if (a == "-gui-address") setGuiAddress(value("an IP address"));
-    else if (a == "-gui-token") setGuiToken(value("a token"));
+    else if (a == "-gui-token") {
+      // Pages present the token in the URL as it is (the Scene Viewer does not percent-decode):
+      // any other character would make a token no page can present.
+      const std::string v = value("a token");
+      if (v.size() > 256 || v.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-._~") !=
+                                std::string::npos)
+        throw std::invalid_argument("switch '-gui-token' needs 1 to 256 letters, digits and - . _ ~ (it goes into the "
+                                    "URL as it is), not '" + v + "'");
+      setGuiToken(v);
+    }
     else if (a == "-gui-port") {
       const std::string v = value("a port number 0..65535");
       std::size_t used = 0;

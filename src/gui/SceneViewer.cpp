@@ -469,11 +469,16 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
     const std::string target(req.target());
     // DNS rebinding: a page of another site whose name was made to resolve to this address sends
     // that name as Host. Only the names this server is known by are accepted.
+    // Exactly one Host header: with two, only the first would be checked, and what a proxy on the
+    // way takes as the host is anyone's guess.
     const auto host = req[http::field::host];
-    if (!impl_.hostAllowed(std::string_view(host.data(), host.size()))) {
+    const bool oneHost = req.count(http::field::host) <= 1;
+    if (!oneHost || !impl_.hostAllowed(std::string_view(host.data(), host.size()))) {
       if (websocket::is_upgrade(req)) impl_.handshakesRefused.fetch_add(1);
       return respond(http::status::forbidden, "text/plain",
-                     "Scene Viewer: this server is not known by the host name in the Host header\n", req);
+                     oneHost ? "Scene Viewer: this server is not known by the host name in the Host header\n"
+                             : "Scene Viewer: a request may have one Host header only\n",
+                     req);
     }
     if (websocket::is_upgrade(req)) {
       std::string why;
@@ -547,8 +552,12 @@ class SceneViewer::Impl::HttpSession : public std::enable_shared_from_this<Scene
     res->set("Content-Security-Policy", "frame-ancestors 'none'");
     res->set("Referrer-Policy", "no-referrer");
     res->keep_alive(req.keep_alive());
-    if (req.method() != http::verb::head) res->body() = std::move(body);
-    res->prepare_payload();
+    if (req.method() != http::verb::head) {
+      res->body() = std::move(body);
+      res->prepare_payload();
+    } else {
+      res->content_length(body.size());  // what a GET would send, without the body
+    }
     http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
       if (ec || !res->keep_alive()) {
         beast::error_code ignored;
@@ -818,13 +827,22 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     if (!str("name", name)) return;
     std::vector<double> values;
     long long index = -1;
-    if (auto v = msg.find("value"); v != msg.end()) {
-      if (!v->is_number()) return refuse("'value' must be a number");
-      values.push_back(v->get<double>());
-      if (auto i = msg.find("index"); i != msg.end()) {
-        if (!i->is_number_integer() || i->get<long long>() < 0 || i->get<long long>() > 1000000)
+    const bool hasValue = msg.contains("value"), hasValues = msg.contains("values"), hasIndex = msg.contains("index");
+    // One form per message: 'value' (every element, or the one at 'index') or 'values' (each
+    // element: exactly as many as the parameter has, checked in the worker). A one-element
+    // 'values' used to go to the whole-parameter form and set every joint's gain to it.
+    if (hasValue && hasValues) return refuse("setParameter takes 'value' or 'values', not both");
+    if (hasIndex && !hasValue) return refuse("'index' goes with 'value' (one element), not with 'values'");
+    if (hasValue) {
+      const json& v = msg["value"];
+      if (!v.is_number()) return refuse("'value' must be a number");
+      values.push_back(v.get<double>());
+      if (hasIndex) {
+        const json& i = msg["index"];
+        if (!i.is_number_integer() || (i.is_number_unsigned() ? i.get<unsigned long long>() > 1000000
+                                                              : i.get<long long>() < 0 || i.get<long long>() > 1000000))
           return refuse("'index' must be a non-negative integer");
-        index = i->get<long long>();
+        index = i.get<long long>();
       }
     } else if (auto vs = msg.find("values"); vs != msg.end() && vs->is_array() && !vs->empty() && vs->size() <= 1024) {
       for (const auto& x : *vs) {
@@ -836,11 +854,11 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
     }
     for (double v : values)
       if (!std::isfinite(v)) return refuse("parameter values must be finite");
-    action = [object, name, values, index] {
+    action = [object, name, values, index, all = hasValues] {
       ObjectReference o = publishedObject(object);
       ControlProgram* p = o->getControlProgram();
       if (!p) throw std::invalid_argument("object '" + object + "' has no tunable parameters");
-      if (values.size() > 1) p->setParameter(name, values);
+      if (all) p->setParameter(name, values);  // throws unless one value per element
       else if (index >= 0) p->setParameter(name, static_cast<std::size_t>(index), values[0]);
       else p->setParameter(name, values[0]);
       json now = p->getParameter(name);
@@ -1051,6 +1069,12 @@ void SceneViewer::start(const SceneViewerOptions& options) {
   beast::error_code ec;
   auto address = asio::ip::make_address(options.address, ec);
   if (ec) throw std::invalid_argument("SceneViewer: '" + options.address + "' is not an IP address");
+
+  if (options.token.size() > 256 ||
+      options.token.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-._~") !=
+          std::string::npos)
+    throw std::invalid_argument("SceneViewer: the token must be at most 256 letters, digits and - . _ ~ (pages present "
+                                "it in the URL as it is)");
 
   m.options = options;
   if (m.options.webRoot.empty()) m.options.webRoot = defaultWebRoot();

@@ -47,6 +47,15 @@ describe('rp-jointmove', () => {
     const err = await ctx.page.evaluate(() => window.rp.conn.message('jointmove', 'setJoint', JSON.stringify({ joint: 0, value: 100 }))
       .then(() => 'accepted', (e) => e.message));
     assert.match(err, /outside/);
+    // A joint index is checked whole: 4294967297 used to be cut to 32 bits and move joint 2.
+    const target = async () => JSON.parse((await ctx.page.evaluate(() => window.rp.conn.message('jointmove', 'read', ''))).reply).target;
+    const before = await target();
+    for (const joint of [4294967297, -4294967295, 6, -1]) {
+      const e = await ctx.page.evaluate((j) => window.rp.conn.message('jointmove', 'setJoint', JSON.stringify({ joint: j, value: 0.5 }))
+        .then(() => 'accepted', (x) => x.message), joint);
+      assert.match(e, /'joint' must be an integer in 0\.\.5/, `joint ${joint}`);
+    }
+    assert.deepEqual(await target(), before);
     const limits = await ctx.page.evaluate(() => {
       const puma = window.rp.scene.objects.find((o) => o.name === 'puma');
       return [...document.querySelectorAll('input[data-joint]')].map((s, i) => ({

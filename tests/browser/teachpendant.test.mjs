@@ -76,7 +76,9 @@ describe('rp-teachpendant', () => {
     await nearStored(1, 0.01);
     const bad = await ctx.page.evaluate(async () => {
       const out = [];
-      for (const [t, p] of [['goto', { index: 7 }], ['push', { force: [1e6, 0, 0] }], ['cycle', { times: 0 }], ['zeroGravity', 'yes']])
+      for (const [t, p] of [['goto', { index: 7 }], ['push', { force: [1e6, 0, 0] }], ['cycle', { times: 0 }], ['zeroGravity', 'yes'],
+        ['cycle', { times: 4294967297 }], ['cycle', { times: -4294967295 }], ['cycle', { indices: new Array(1001).fill(0) }],
+        ['push', { force: [0, 61, 0] }]])
         out.push(await window.rp.conn.message('teachpendant', t, JSON.stringify(p)).then(() => 'accepted', (e) => e.message));
       return out;
     });
@@ -84,9 +86,18 @@ describe('rp-teachpendant', () => {
     assert.match(bad[1], /within/);
     assert.match(bad[2], /'times' must be 1 to 100/);
     assert.match(bad[3], /true or false/);
+    // 'times' is checked whole (4294967297 used to wrap to 1 and start cycling), and the list of
+    // indices is bounded (30,000 indices 100 times took half a gigabyte).
+    assert.match(bad[4], /'times' must be 1 to 100/);
+    assert.match(bad[5], /'times' must be 1 to 100/);
+    assert.match(bad[6], /at most 1000 positions/);
+    assert.match(bad[7], /within \+-60 N/, 'no client pushes harder than the page (60 N)');
   });
 
-  it('Stop stops a motion at once: the arm comes to rest short of the target', async () => {
+  // Go to the stored position farthest from the arm, and Stop as soon as the arm has started
+  // to move; checks where the arm comes to rest. Returns that position's index.
+  async function goAndStop() {
+    await waitInPage(ctx.page, () => window.rp.state && !window.rp.state.busy, null, 20000);  // the last motion's end
     const q = await joints();
     const { positions } = await state();
     let far = 0;
@@ -134,9 +145,22 @@ describe('rp-teachpendant', () => {
       assert.ok(distance(rest, positions[far].q) > 0.01,
         `the arm went on to ${distance(rest, positions[far].q)} rad from the target (${remaining} rad remained at Stop)`);
     }
+    return far;
+  }
+
+  it('Stop stops a motion at once: the arm comes to rest short of the target', async () => {
+    const far = await goAndStop();
     // Go still works after a Stop.
     await ctx.page.evaluate((i) => window.rp.conn.message('teachpendant', 'goto', JSON.stringify({ index: i })), far);
     await nearStored(far, 0.01);
+  });
+
+  it('Stop works every time, not only the first', async () => {
+    // Each Stop builds a brake while the last one still exists: under one fixed name every Stop
+    // after the first was refused ("an object named 'teachpendant.brake' already exists") and the
+    // arm went on to the target.
+    await goAndStop();
+    await goAndStop();
   });
 
   it('a push force lapses when the page stops repeating it', async () => {

@@ -174,10 +174,15 @@ describe('Scene Viewer on work_cell', () => {
           out.push('taken');
         } catch (e) { out.push(e.message); }
       }
-      try {
-        await window.rp.conn.request({ type: 'setParameter', object: 'puma', name: 'kp', values: [1, 2] });
-        out.push('taken');
-      } catch (e) { out.push(e.message); }
+      // 'values' sets each element: one number is refused (it used to set all six gains to it),
+      // and a message mixing the forms is refused whole.
+      for (const extra of [{ values: [1, 2] }, { values: [0] }, { values: [5], index: 2 },
+        { value: 7, index: 2, values: [1, 2, 3, 4, 5, 6] }, { index: 2 }]) {
+        try {
+          await window.rp.conn.request({ type: 'setParameter', object: 'puma', name: 'kp', ...extra });
+          out.push('taken');
+        } catch (e) { out.push(e.message); }
+      }
       return out;
     });
     assert.match(refused[0], /'value' must be a number/);
@@ -185,6 +190,15 @@ describe('Scene Viewer on work_cell', () => {
     assert.match(refused[2], /'kp' = -1.* is outside/);
     assert.match(refused[3], /'kp' = .* is outside/);
     assert.match(refused[4], /'kp' needs 6 values, got 2/);
+    assert.match(refused[5], /'kp' needs 6 values, got 1/);
+    assert.match(refused[6], /'index' goes with 'value'/);
+    assert.match(refused[7], /'value' or 'values', not both/);
+    assert.match(refused[8], /'index' goes with 'value'/);
+    // None of them changed a gain.
+    const kpNow = await ctx.page.evaluate(async () => JSON.parse((await window.rp.conn.request({
+      type: 'setParameter', object: 'puma', name: 'kp', value: 1200, index: 2 })).reply));
+    assert.equal(kpNow[2], 1200);
+    assert.ok(kpNow.every((g) => g > 1), `a refused message changed the gains: ${kpNow}`);
   });
 
   it('two pages at once both receive state', async () => {

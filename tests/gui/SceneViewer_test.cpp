@@ -79,6 +79,23 @@ Reply get(int port, const std::string& target, const std::string& origin = "", b
   return r;
 }
 
+// Sends `request` as it is and returns everything the server sends until it closes.
+std::string rawRequest(int port, const std::string& request) {
+  asio::io_context ioc;
+  tcp::socket socket(ioc);
+  socket.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)));
+  asio::write(socket, asio::buffer(request));
+  std::string out;
+  beast::error_code ec;
+  char chunk[4096];
+  for (;;) {
+    const std::size_t got = socket.read_some(asio::buffer(chunk), ec);
+    out.append(chunk, got);
+    if (ec) break;
+  }
+  return out;
+}
+
 TEST(SceneViewer, ServesFilesAndRefusesBadPaths) {
   rp::SceneViewer& v = rp::SceneViewer::instance();
   rp::SceneViewerOptions o;
@@ -187,6 +204,23 @@ TEST(SceneViewer, HostHeaderAndFraming) {
     ++refused;
   }
   EXPECT_EQ(v.getStatistics().handshakesRefused, static_cast<std::uint64_t>(refused));
+  // Two Host headers, in either order: refused (only the first used to be checked).
+  for (const std::string& hosts : std::vector<std::string>{"Host: 127.0.0.1:" + p + "\r\nHost: evil.example\r\n",
+                                                           "Host: evil.example\r\nHost: 127.0.0.1:" + p + "\r\n",
+                                                           "Host: 127.0.0.1:" + p + "\r\nHost: 127.0.0.1:" + p + "\r\n"}) {
+    SCOPED_TRACE(hosts);
+    const std::string head = rawRequest(port, "GET /index.html HTTP/1.1\r\n" + hosts + "Connection: close\r\n\r\n");
+    EXPECT_EQ(head.substr(0, 12), "HTTP/1.1 403") << head;
+    EXPECT_EQ(head.find("<html"), std::string::npos);
+  }
+  // HEAD: the length a GET would send, and no body.
+  {
+    const std::string head = rawRequest(port, "HEAD /api/info HTTP/1.1\r\nHost: 127.0.0.1:" + p + "\r\nConnection: close\r\n\r\n");
+    const std::string body = get(port, "/api/info").body;
+    EXPECT_EQ(head.substr(0, 12), "HTTP/1.1 200") << head;
+    EXPECT_NE(head.find("Content-Length: " + std::to_string(body.size()) + "\r\n"), std::string::npos) << head;
+    EXPECT_EQ(head.substr(head.find("\r\n\r\n") + 4), "") << "a HEAD reply with a body";
+  }
   // No other site may put the pages in a frame.
   Reply index = get(port, "/");
   EXPECT_EQ(index.headers["X-Frame-Options"], "DENY");
@@ -232,6 +266,18 @@ TEST(SceneViewer, TokenRules) {
   EXPECT_EQ(v.getToken().size(), 32u);
   EXPECT_NE(v.getUrl().find("?token=" + v.getToken()), std::string::npos);
   EXPECT_EQ(get(v.getPort(), "/ws", "", true).status, 403);
+  v.stop();
+  // A token the page could not present in the URL as it is (the server does not percent-decode)
+  // is refused at the start, not taken to lock every page out.
+  o.address = "127.0.0.1";
+  for (const std::string& bad : std::vector<std::string>{"a&b c", "a b", "x#y", "t%26", "caf\xc3\xa9", std::string(257, 'a')}) {
+    o.token = bad;
+    EXPECT_THROW(v.start(o), std::invalid_argument) << bad;
+    EXPECT_FALSE(v.isRunning()) << bad;
+  }
+  o.token = "Az09-._~";
+  v.start(o);
+  EXPECT_EQ(get(v.getPort(), "/ws?token=Az09-._~", "", true).status, 101);
   v.stop();
 }
 
@@ -554,6 +600,15 @@ TEST(SceneViewer, PlatformSwitches) {
     }
   }
   EXPECT_THROW(rp::RoboticPlatform::parseCommandLine({"-gui-address"}), std::invalid_argument);
+  for (const char* bad : {"a&b c", "t?x", "a/b"}) {
+    try {
+      rp::RoboticPlatform::parseCommandLine({"-gui-token", bad});
+      FAIL() << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("-gui-token"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(rp::RoboticPlatform::getGuiToken(), "abc") << "a refused token replaced the last";
   EXPECT_THROW(rp::RoboticPlatform::setGuiPort(70000), std::invalid_argument);
   rp::RoboticPlatform::setGuiAddress("127.0.0.1");
   rp::RoboticPlatform::setGuiPort(-1);
