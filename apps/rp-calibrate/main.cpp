@@ -53,7 +53,7 @@ const char* kUsage =
     "  --offsets on|off     fit the encoder offsets (default on); off: they are known to be 0\n"
     "  --poses N            poses passed through for gravity and offsets (default 8)\n"
     "  --seed N             seed of the random poses (default 1)\n"
-    "  --pass-speed V       speed of the passes through the poses [rad/s] (default 0.1)\n"
+    "  --pass-speed V       speed of the passes through the poses [rad/s] (default 0.1, at least 0.01)\n"
     "  --sweep-speeds LIST  speeds of the friction sweeps [rad/s] (default 0.15,0.4,0.8)\n"
     "  --sweep-range R      the sweeps cover the middle of each joint's range +- R [rad] (default 0.5)\n"
     "Speeds are capped at half of each joint's velocity limit. Exit status: 0, 1 if the fit fails, 2 on a\n"
@@ -64,6 +64,16 @@ double number(const std::string& option, const std::string& text) {
   const double x = std::strtod(text.c_str(), &end);
   if (text.empty() || end == text.c_str() || *end != '\0' || !std::isfinite(x) || !(x > 0))
     throw UsageError(option + ": '" + text + "' is not a positive number");
+  return x;
+}
+
+// The least speed of a pass or sweep [rad/s]: the plan's duration, and the samples it keeps, grow
+// as 1 / speed (--pass-speed 1e-5 asked for about 10 GB, 1e-4 ran on for minutes).
+constexpr double kMinSpeed = 0.01;
+
+double speed(const std::string& option, const std::string& text) {
+  const double x = number(option, text);
+  if (x < kMinSpeed) throw UsageError(option + ": '" + text + "' is below the least speed, 0.01 rad/s");
   return x;
 }
 
@@ -118,14 +128,14 @@ Options parse(int argc, char** argv) {
     } else if (a == "--seed") {
       o.plan.seed = static_cast<unsigned>(integer(a, v, 0, 1000000000));
     } else if (a == "--pass-speed") {
-      o.plan.passSpeed = number(a, v);
+      o.plan.passSpeed = speed(a, v);
     } else if (a == "--sweep-range") {
       o.plan.sweepRange = number(a, v);
     } else {  // --sweep-speeds
       o.plan.sweepSpeeds.clear();
       std::stringstream ss(v);
       std::string item;
-      while (std::getline(ss, item, ',')) o.plan.sweepSpeeds.push_back(number(a, item));
+      while (std::getline(ss, item, ',')) o.plan.sweepSpeeds.push_back(speed(a, item));
       if (o.plan.sweepSpeeds.empty() || v.back() == ',') throw UsageError("--sweep-speeds: '" + v + "' is not a list of speeds");
     }
   }

@@ -95,6 +95,10 @@ int main(int argc, char** argv) {
       }
     }
     if (modbus.port < 0 || modbus.port > 65535) throw UsageError("-port must be 0 .. 65535");
+    if (duration < 0) throw UsageError("-duration must not be negative (0: until a signal)");
+    if (hand.moveTimeMs < 0) throw UsageError("-movetime must not be negative");
+    for (const int every : {faults.dropEvery, faults.reorderEvery, faults.garbleEvery, faults.truncateEvery})
+      if (every < 0) throw UsageError("-drop, -reorder, -garble and -truncate must not be negative (0: never)");
   } catch (const UsageError& e) {
     std::cerr << "rp-emulate: " << e.what() << "\n" << kUsage;
     return 2;

@@ -121,6 +121,7 @@ int run(int argc, char** argv) {
                    "COMMAND: fk jacobian gravity rnea inertia fd ik urdf mjcf\n";
       return 0;
     }
+    if (a.rfind("--", 0) == 0 && opts.count(a)) throw UsageError(a + " is given twice");
     if (a == "--motor-inertia" || a == "--friction") {
       opts[a] = "1";
     } else if (a.rfind("--", 0) == 0) {
@@ -164,6 +165,28 @@ int run(int argc, char** argv) {
                                                    "--seed", "--motor-inertia", "--friction"};
     if (std::find(known.begin(), known.end(), key) == known.end()) throw UsageError("unknown option " + key);
     (void)value;
+  }
+  // An option the command does not read is refused rather than ignored (fk --tau 1,2 was taken
+  // without a word, and puma560 ik never parsed its --seed).
+  static const std::map<std::string, std::vector<std::string>> reads = {
+      {"fk", {"--q"}},
+      {"jacobian", {"--q"}},
+      {"gravity", {"--q"}},
+      {"rnea", {"--q", "--qd", "--qdd", "--motor-inertia", "--friction"}},
+      {"inertia", {"--q", "--motor-inertia"}},
+      {"fd", {"--q", "--qd", "--tau", "--motor-inertia", "--friction"}},
+      {"ik", {"--pose", "--seed"}},
+      {"urdf", {}},
+      {"mjcf", {}}};
+  if (const auto r = reads.find(command); r != reads.end()) {
+    for (const auto& [key, value] : opts) {
+      if (key == "--robot" || key == "--tip" || key == "--offchain") continue;
+      if (std::find(r->second.begin(), r->second.end(), key) == r->second.end())
+        throw UsageError(key + " does not apply to " + command);
+      if (key == "--seed" && dynamic_cast<const Puma560Model*>(model.get()))
+        throw UsageError("--seed does not apply to puma560 ik (its closed form gives all eight solutions)");
+      (void)value;
+    }
   }
   const int n = model->getNumberOfJoints();
   ManipulatorData data(*model);

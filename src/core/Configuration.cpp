@@ -36,7 +36,8 @@ bool parseNumber(const std::string& token, double& value) {
   const char* begin = token.data();
   const char* end = token.data() + token.size();
   if (begin != end && *begin == '+') ++begin;
-  if (begin == end) return false;
+  // One sign only: from_chars takes a '-' of its own, so "+-5" would be -5.
+  if (begin == end || (begin != token.data() && *begin == '-')) return false;
   auto [ptr, ec] = std::from_chars(begin, end, value);
   return ec == std::errc() && ptr == end;
 }
@@ -200,11 +201,12 @@ void checkSetting(const SettingSpec& spec, const ConfigSetting& s, const std::st
         break;
       }
       case SettingKind::Integer: {
-        long long x;
+        long long x = 0;
         const char* b = v.data();
         if (!v.empty() && v[0] == '+') ++b;
         auto [ptr, ec] = std::from_chars(b, v.data() + v.size(), x);
-        const bool whole = ptr == v.data() + v.size() && b != v.data() + v.size();
+        // (One sign only: "+-5" is no integer.)
+        const bool whole = ptr == v.data() + v.size() && b != v.data() + v.size() && !(b != v.data() && *b == '-');
         if (ec == std::errc::result_out_of_range && whole)
           throw ConfigError(file, s.line, "setting '" + ex(s.name) + "': '" + ex(v) + "' is outside " + describeRange(spec));
         if (ec != std::errc() || !whole)

@@ -1,7 +1,6 @@
 // A manipulator described by a URDF file (rp/manipulator/UrdfManipulator.hpp).
 #include "rp/manipulator/UrdfManipulator.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -15,6 +14,10 @@
 #include "rp/gui/UrdfVisuals.hpp"
 
 namespace rp {
+
+namespace internal {
+bool parseNumber(const std::string& token, double& value);  // Configuration.cpp: a whole token, one sign
+}  // namespace internal
 
 namespace {
 // The URDF file and tip link: rp.cfg's settings override the constructor's arguments.
@@ -46,10 +49,8 @@ std::map<std::string, double> offChainSetting(const ConfigSection* section) {
       throw section->errorAt(*setting, "offChainPositions: " + quoted +
                                            " is not a joint=value pair (value in deg, or mm for a prismatic joint)");
     const std::string joint = word.substr(0, eq), text = word.substr(eq + 1);
-    const char* begin = text.data() + (text[0] == '+' ? 1 : 0);
     double value = 0;
-    const auto [end, ec] = std::from_chars(begin, text.data() + text.size(), value);
-    if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
+    if (!internal::parseNumber(text, value) || !std::isfinite(value))  // (rp.cfg's numbers: "+-5" is none)
       throw section->errorAt(*setting, "offChainPositions: joint '" + ConfigError::excerpt(joint) + "': '" +
                                            ConfigError::excerpt(text) + "' is not a finite number");
     if (!positions.emplace(joint, value).second)

@@ -1464,6 +1464,7 @@ bool parseNumber(const std::string& token, double& value);  // Configuration.cpp
 namespace {
 
 // Ranges of the control-program settings a qmotorConfig file may give (docs/core.md).
+constexpr double kMinQMotorRate = 1;  // Hz: a period of at most 1 s (rate 1e-11 overflowed the period)
 constexpr double kMaxQMotorRate = ControlProgram::kMaxRate;  // Hz
 constexpr long long kMaxQMotorLogEvery = ControlProgram::kMaxLogEvery;  // cycles
 constexpr auto kMaxQMotorLogBuffer = static_cast<long long>(ControlProgram::kMaxLogBufferSize);  // samples
@@ -1521,7 +1522,7 @@ void ControlProgram::applyQMotorConfig(const ParameterFile& file) {
     for (const auto& e : file.entries()) {
       try {
         if (e.name == "rate") {
-          const double v = qmotorNumber(file, e, 0, kMaxQMotorRate, true, "Hz");
+          const double v = qmotorNumber(file, e, kMinQMotorRate, kMaxQMotorRate, false, "Hz");
           setting(e, v == d.rate, apply, [&] { setRate(v); });
         } else if (e.name == "priority") {
           const int v = static_cast<int>(qmotorInteger(file, e, 1, 99));

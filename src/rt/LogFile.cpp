@@ -22,11 +22,31 @@ std::string quoted(const std::string& name) { return "'" + name + "'"; }
 
 std::string errorText(int e) { return std::strerror(e); }
 
+// Whether the regular file `name` may be replaced by a log: it is empty, or a log itself (its
+// header line starts with the time column, "t," or "t" alone). Anything else - the program's
+// rp.cfg, a URDF, a log of another tool - is someone's data.
+bool replaceableByALog(const std::string& name) {
+  const int fd = ::open(name.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
+  if (fd < 0) return true;  // unreadable: opening it for writing will say why
+  char head[2] = {0, 0};
+  ssize_t got = 0;
+  do {
+    got = ::read(fd, head, sizeof head);
+  } while (got < 0 && errno == EINTR);
+  ::close(fd);
+  return got <= 0 || (head[0] == 't' && (got == 1 || head[1] == ',' || head[1] == '\n' || head[1] == '\r'));
+}
+
 }  // namespace
 
 LogFile::LogFile(const std::string& fileName) : fileName_(fileName) {
   auto refuse = [&](const std::string& why) { throw std::runtime_error(quoted(fileName) + (why.compare(0, 3, "is ") == 0 ? " " : ": ") + why); };
   if (fileName.empty()) refuse("no file name");
+  auto refuseUnlessALog = [&](const std::string& what) {
+    if (!replaceableByALog(fileName))
+      refuse(what + "a file that is not a log (its first line is no header 't,...'): a log never replaces it (name "
+             "another file, or remove this one)");
+  };
   struct stat st {};
   if (::lstat(fileName.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
     // Not a regular file: it is never replaced; a stream (FIFO, terminal, /dev/null, a link) is
@@ -38,6 +58,7 @@ LogFile::LogFile(const std::string& fileName) : fileName_(fileName) {
     const std::string what = link ? "is a symbolic link to " : "is ";
     if (S_ISDIR(target.st_mode)) refuse(what + "a directory (name a file in it, e.g. " + quoted(fileName + "/log.csv") + ")");
     if (S_ISBLK(target.st_mode)) refuse(what + "a block device (a log is never written over a disk)");
+    if (link && S_ISREG(target.st_mode)) refuseUnlessALog(what);  // written in place: truncated first
     if (!S_ISFIFO(target.st_mode) && !S_ISCHR(target.st_mode) && !S_ISREG(target.st_mode))
       refuse(what + "neither a regular file, a FIFO nor a character device");
     const bool fifo = S_ISFIFO(target.st_mode);
@@ -68,6 +89,7 @@ LogFile::LogFile(const std::string& fileName) : fileName_(fileName) {
     return;
   }
   // Absent or a regular file: the rows go to FILE.part, which only this run may write.
+  if (S_ISREG(st.st_mode)) refuseUnlessALog("is ");
   writingTo_ = fileName + ".part";
   fd_ = ::open(writingTo_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0666);
   if (fd_ < 0) {

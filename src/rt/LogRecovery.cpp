@@ -3,6 +3,7 @@
 #include "rp/rt/LogRecovery.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -142,6 +143,20 @@ LogRecovery writeCompleteLog(const std::string& partFile, int fd, const std::str
 }  // namespace internal
 
 LogRecovery recoverLog(const std::string& partFile, const std::string& outFile) {
+  // The input is a file a run left: a regular file (a FIFO would wait for a writer forever, a
+  // device such as /dev/zero would be read without end). Checked before the output is created.
+  struct stat st {};
+  if (::stat(partFile.c_str(), &st) != 0) {
+    const int e = errno;
+    throw std::runtime_error(partFile + ": cannot open: " + std::strerror(e));
+  }
+  if (!S_ISREG(st.st_mode))
+    throw std::runtime_error(partFile + ": is " +
+                             (S_ISDIR(st.st_mode)    ? "a directory"
+                              : S_ISFIFO(st.st_mode) ? "a FIFO"
+                              : S_ISCHR(st.st_mode)  ? "a character device"
+                                                     : "not a regular file") +
+                             ": a log a run left (FILE.part) is a regular file");
   if (outFile == "-") return internal::writeCompleteLog(partFile, STDOUT_FILENO, "stdout");
   {  // Check the input before creating the output.
     std::ifstream probe(partFile, std::ios::binary);

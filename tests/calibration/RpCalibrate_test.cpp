@@ -250,6 +250,8 @@ TEST(RpCalibrate, BadArgumentsExitWith2AndNameTheArgument) {
       {"--offsets maybe", "rp-calibrate: --offsets: 'maybe' is not on or off\n"},
       {"--sweep-speeds 0.1,x", "rp-calibrate: --sweep-speeds: 'x' is not a positive number\n"},
       {"--pass-speed -1", "rp-calibrate: --pass-speed: '-1' is not a positive number\n"},
+      {"--pass-speed 1e-5", "rp-calibrate: --pass-speed: '1e-5' is below the least speed, 0.01 rad/s\n"},
+      {"--sweep-speeds 0.1,0.001", "rp-calibrate: --sweep-speeds: '0.001' is below the least speed, 0.01 rad/s\n"},
       {"--frobnicate", "rp-calibrate: unknown option --frobnicate\n"},
       {"--json --json2", "rp-calibrate: unknown option --json2\n"},
       {"--seed 1 --seed 2", "rp-calibrate: --seed is given twice\n"},

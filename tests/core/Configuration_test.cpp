@@ -155,6 +155,9 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"[a]\nclass TestArm\nposition 1 abc 3\n", "rp.cfg:3: setting 'position': 'abc' is not a number"},
         Malformed{"[a]\nclass TestArm\nposition 1 2 -\n", "rp.cfg:3: setting 'position': '-' is not a number"},
         Malformed{"[a]\nclass TestArm\nposition 1 2 3mm\n", "rp.cfg:3: setting 'position': '3mm' is not a number"},
+        // One sign only (both used to be taken as -5).
+        Malformed{"[a]\nclass TestArm\nposition +-5 0 0\n", "rp.cfg:3: setting 'position': '+-5' is not a number"},
+        Malformed{"[a]\nclass TestArm\ncount +-5\n", "rp.cfg:3: setting 'count': '+-5' is not an integer"},
         Malformed{"[a]\nclass TestArm\nposition nan 0 0\n",
                   "rp.cfg:3: setting 'position': 'nan' is not a finite number"},
         Malformed{"[a]\nclass TestArm\nposition 0 inf 0\n",

@@ -243,6 +243,14 @@ TEST(RpHwServer, DrivesModbusCoilsAndReportsTheBoardFailing) {
 TEST(RpHwServer, BadArgumentsExitWithStatus2) {
   test::ChildProcess server({RP_HWSERVER_PATH, "-name", "x", "-board", "nonsense"});
   EXPECT_EQ(server.wait(5000), 2);
+  // Numbers that are not finite: -duration nan used to run the server until it was killed.
+  for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
+           {"-duration", "nan"}, {"-duration", "inf"}, {"-countsPerRadian", "inf"}, {"-rate", "nan"}}) {
+    test::ChildProcess bad({RP_HWSERVER_PATH, "-name", "rp-test-bad-args", "-board", "simulated", option, value}, true);
+    EXPECT_EQ(bad.readLine(5000).value_or("(nothing)"),
+              "rp-hwserver: " + option + ": '" + value + "' is not a finite number");
+    EXPECT_EQ(bad.wait(5000), 2) << option << " " << value;
+  }
 }
 
 }  // namespace

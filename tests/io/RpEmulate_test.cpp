@@ -78,6 +78,19 @@ TEST(RpEmulate, BadArgumentsExitWithStatus2) {
   EXPECT_EQ(a.wait(5000), 2);
   test::ChildProcess b({RP_EMULATE_PATH, "netft", "-rate", "fast"});
   EXPECT_EQ(b.wait(5000), 2);
+  // These used to run until killed (-duration), or to be taken as given.
+  for (const auto& [args, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"modbus", "-duration", "-1"}, "rp-emulate: -duration must not be negative (0: until a signal)"},
+           {{"modbus", "-duration", "nan"}, "rp-emulate: -duration: 'nan' is not a finite number"},
+           {{"barretthand", "-movetime", "-5"}, "rp-emulate: -movetime must not be negative"},
+           {{"netft", "-drop", "-1"}, "rp-emulate: -drop, -reorder, -garble and -truncate must not be negative (0: never)"},
+           {{"netft", "-wrench", "0", "0", "nan", "0", "0", "0"}, "rp-emulate: -wrench: 'nan' is not a finite number"}}) {
+    std::vector<std::string> argv{RP_EMULATE_PATH};
+    argv.insert(argv.end(), args.begin(), args.end());
+    test::ChildProcess c(argv, true);
+    EXPECT_EQ(c.readLine(5000).value_or("(nothing)"), message) << args[1];
+    EXPECT_EQ(c.wait(5000), 2) << args[1];
+  }
 }
 
 }  // namespace

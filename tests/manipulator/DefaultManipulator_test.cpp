@@ -893,6 +893,7 @@ TEST_F(ManipulatorTest, UrdfArmLumpsLinksOffTheChainWhereRpCfgSays) {
   for (const auto& [value, message] : std::vector<std::pair<std::string, std::string>>{
            {"nosuch=0", "offChainPositions: there is no joint 'nosuch' (moving joints off the chain: jointGripper) in "},
            {"jointGripper=open", "offChainPositions: joint 'jointGripper': 'open' is not a finite number"},
+           {"jointGripper=+-10", "offChainPositions: joint 'jointGripper': '+-10' is not a finite number"},
            {"jointGripper", "offChainPositions: 'jointGripper' is not a joint=value pair"},
            {"jointGripper=10", "offChainPositions: joint 'jointGripper': 10 deg is outside its limits -89.9544 .. 0 deg in "},
            {"joint3=5", "offChainPositions: joint 'joint3' is a joint of the arm, not off the chain"},

@@ -41,7 +41,14 @@ set(cases
   "--robot ${DATA}/jaw_arm.urdf --offchain jointGripper fk --q 0,0,0,0,0,0 => --offchain: 'jointGripper' is not a name=value pair"
   "--robot ${DATA}/jaw_arm.urdf --offchain joint2=0.1 fk --q 0,0,0,0,0,0 => --offchain: joint 'joint2' is a joint of the arm, not off the chain"
   "--robot ${DATA}/jaw_arm.urdf --offchain jointGripper=-1,jointGripper=-0.5 fk --q 0,0,0,0,0,0 => --offchain: joint 'jointGripper' is given twice"
-  "--robot puma560 --offchain jointGripper=0 fk --q 0,0,0,0,0,0 => --offchain applies to URDF robots only")
+  "--robot puma560 --offchain jointGripper=0 fk --q 0,0,0,0,0,0 => --offchain applies to URDF robots only"
+  # An option given twice, or one the command does not read: the last --q used to win, and fk
+  # --tau or puma560 ik --seed (never parsed) were taken without a word.
+  "--robot puma560 fk --q 0,0,0,0,0,0 --q 1,1,1,1,1,1 => --q is given twice$"
+  "--robot puma560 rnea --q 0,0,0,0,0,0 --qd 0,0,0,0,0,0 --qdd 0,0,0,0,0,0 --friction --friction => --friction is given twice$"
+  "--robot puma560 fk --q 0,0,0,0,0,0 --tau 1,2 => --tau does not apply to fk$"
+  "--robot puma560 inertia --q 0,0,0,0,0,0 --friction => --friction does not apply to inertia$"
+  "--robot puma560 ik --pose 0,0,1,0.5963,0,1,0,-0.15005,-1,0,0,0.65748,0,0,0,1 --seed 0,0,0,0,0,0x => --seed does not apply to puma560 ik")
 set(count 0)
 foreach(args IN LISTS cases)
   # "ARGS => REGEX": the message must also match REGEX.
@@ -66,6 +73,6 @@ foreach(args IN LISTS cases)
   message("rp-model ${shown} -> ${err}")
   math(EXPR count "${count} + 1")
 endforeach()
-if(NOT count EQUAL 33)
-  message(FATAL_ERROR "${count} cases ran, expected 33")
+if(NOT count EQUAL 38)
+  message(FATAL_ERROR "${count} cases ran, expected 38")
 endif()

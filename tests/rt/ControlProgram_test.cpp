@@ -385,7 +385,7 @@ TEST(ControlProgram, QMotorConfigFile) {
   EXPECT_EQ(message("kp 1 2\n"), "leader.cfg:1: ControlProgram leader: parameter 'kp' needs 3 values, got 2");
   EXPECT_EQ(message("rate 1 2\n"), "leader.cfg:1: 'rate' needs 1 value, got 2");
   EXPECT_EQ(message("log q tau\n"), "leader.cfg:1: 'log': 'tau' is not a log variable of leader (known: x, q)");
-  EXPECT_EQ(message("rate -5\n"), "leader.cfg:1: 'rate' must be a number in (0, 20000] Hz, got '-5'");
+  EXPECT_EQ(message("rate -5\n"), "leader.cfg:1: 'rate' must be a number in [1, 20000] Hz, got '-5'");
   EXPECT_EQ(message("kp 7\n"), "no error");  // one value for every element
   EXPECT_EQ(r.kp(2), 7.0);
 
@@ -420,8 +420,12 @@ TEST(ControlProgram, QMotorConfigValuesAreBounded) {
   EXPECT_EQ(message("logBufferSize 1\n"), "leader.cfg:1: 'logBufferSize' must be an integer in 2..1000000, got '1'");
   EXPECT_EQ(message("logBufferSize 100.5\n"),
             "leader.cfg:1: 'logBufferSize' must be an integer in 2..1000000, got '100.5'");
-  EXPECT_EQ(message("rate 1e9\n"), "leader.cfg:1: 'rate' must be a number in (0, 20000] Hz, got '1e9'");
-  EXPECT_EQ(message("rate 0\n"), "leader.cfg:1: 'rate' must be a number in (0, 20000] Hz, got '0'");
+  EXPECT_EQ(message("rate 1e9\n"), "leader.cfg:1: 'rate' must be a number in [1, 20000] Hz, got '1e9'");
+  EXPECT_EQ(message("rate 0\n"), "leader.cfg:1: 'rate' must be a number in [1, 20000] Hz, got '0'");
+  // A period over a second: rate 1e-11 overflowed the period in nanoseconds (the simulated arm's
+  // joints became NaN), 1e-3 left a shutdown waiting 1000 s for the cycle.
+  EXPECT_EQ(message("rate 0.5\n"), "leader.cfg:1: 'rate' must be a number in [1, 20000] Hz, got '0.5'");
+  EXPECT_EQ(message("rate 1e-11\n"), "leader.cfg:1: 'rate' must be a number in [1, 20000] Hz, got '1e-11'");
   EXPECT_EQ(message("logEvery 4294967297\n"),
             "leader.cfg:1: 'logEvery' must be an integer in 1..1000000, got '4294967297'");
   EXPECT_EQ(message("logEvery 0\n"), "leader.cfg:1: 'logEvery' must be an integer in 1..1000000, got '0'");
@@ -434,8 +438,8 @@ TEST(ControlProgram, QMotorConfigValuesAreBounded) {
   EXPECT_EQ(r.getRate(), 20000.0);
   EXPECT_EQ(r.getLogEvery(), 1000000u);
   EXPECT_EQ(r.getPriority(), 99);
-  EXPECT_EQ(message("rate 1e-3\nlogEvery 1e3\nlogBufferSize +2\npriority 1\n"), "no error");
-  EXPECT_EQ(r.getRate(), 1e-3);
+  EXPECT_EQ(message("rate 1e0\nlogEvery 1e3\nlogBufferSize +2\npriority 1\n"), "no error");
+  EXPECT_EQ(r.getRate(), 1.0);
   EXPECT_EQ(r.getLogEvery(), 1000u);
   // A huge word is quoted as a short excerpt only.
   const std::string huge(10 << 20, 'q');

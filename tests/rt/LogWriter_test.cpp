@@ -244,6 +244,40 @@ TEST(LogWriterFile, ASecondRunOfTheSameFileIsRefused) {
   expectCompleteRows(slurp(file), 10);
 }
 
+// `-log rp.cfg` (a slip of the keyboard) used to replace the program's own configuration with
+// its log. A file that is not a log - no header line "t,..." - is never replaced or truncated,
+// named directly or through a link; an empty file and an older log are.
+TEST(LogWriterFile, AFileThatIsNotALogIsNeverReplaced) {
+  auto dir = scratch("notalog");
+  const std::string config = "[puma]\nclass Puma560\n";
+  std::ofstream(dir / "rp.cfg") << config;
+  fs::create_symlink("rp.cfg", dir / "link.csv");
+  for (const char* name : {"rp.cfg", "link.csv"}) {
+    SCOPED_TRACE(name);
+    try {
+      LogWriter writer((dir / name).string());
+      FAIL() << "a configuration file was taken as the log";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("a file that is not a log"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(dir / "rp.cfg"), config);
+  }
+  EXPECT_EQ(directory(dir), (std::vector<std::string>{"link.csv", "rp.cfg"}));
+  // An empty file, and a log of an earlier run, are replaced.
+  SimulatedClock clock(1e-3);
+  std::ofstream(dir / "empty.csv").flush();
+  std::ofstream(dir / "old.csv") << "t,arm.q[0]\n0.001,0.5\n";
+  for (const char* name : {"empty.csv", "old.csv"}) {
+    SCOPED_TRACE(name);
+    LogWriter writer((dir / name).string());
+    logCycles(writer, clock, 20);
+    writer.close();
+    EXPECT_FALSE(writer.hasFailed()) << writer.getError();
+    expectCompleteRows(slurp(dir / name), 20);
+  }
+}
+
 TEST(LogWriterFile, AFifoIsWrittenInPlace) {
   auto dir = scratch("fifo");
   const auto fifo = dir / "log.fifo";
@@ -281,7 +315,7 @@ TEST(LogWriterFile, AFifoNobodyReadsIsRefused) {
 
 TEST(LogWriterFile, ASymbolicLinkIsWrittenThroughAndKept) {
   auto dir = scratch("symlink");
-  std::ofstream(dir / "run1.csv") << "an older log\n";
+  std::ofstream(dir / "run1.csv") << "t,arm.q[0]\n0.001,0.5\n";  // an older log
   fs::create_symlink("run1.csv", dir / "latest.csv");
   {
     LogWriter writer((dir / "latest.csv").string());
@@ -466,6 +500,24 @@ TEST(LogRecovery, BadInputIsRefusedNamingTheLine) {
   expectRecoveryError(dir, "t,a.x\n0,1\nt,b.x,a.x\n", ":3: a header that does not extend the one before it");
   EXPECT_THROW(recoverLog((dir / "missing.part").string(), (dir / "out.csv").string()), std::runtime_error);
   EXPECT_FALSE(fs::exists(dir / "out.csv"));
+  // Only a regular file is read: a FIFO used to wait for a writer forever, /dev/zero to be read
+  // into memory without end (6 GB in 20 s), to a file or to stdout alike.
+  ASSERT_EQ(::mkfifo((dir / "fifo.part").c_str(), 0600), 0);
+  fs::create_symlink("/dev/zero", dir / "zero.part");
+  fs::create_directory(dir / "dir.part");
+  for (const auto& [name, kind] : std::vector<std::pair<std::string, std::string>>{
+           {"fifo.part", "a FIFO"}, {"zero.part", "a character device"}, {"dir.part", "a directory"}}) {
+    for (const std::string& out : std::vector<std::string>{(dir / "out.csv").string(), "-"}) {
+      SCOPED_TRACE(name + " to " + out);
+      try {
+        recoverLog((dir / name).string(), out);
+        ADD_FAILURE() << "accepted";
+      } catch (const std::runtime_error& e) {
+        EXPECT_EQ(e.what(), (dir / name).string() + ": is " + kind + ": a log a run left (FILE.part) is a regular file");
+      }
+      EXPECT_FALSE(fs::exists(dir / "out.csv"));
+    }
+  }
 }
 
 TEST(LogRecovery, TheWidestHeaderAndEveryCompleteRowPadded) {

@@ -1,6 +1,7 @@
 #pragma once
 // Command-line helpers shared by rp-emulate, rp-hwserver and rp-device: numbers and lists that
 // say which option was wrong.
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -13,14 +14,15 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A finite number (nan and inf are no durations, rates or forces).
 inline double toDouble(const std::string& option, const std::string& text) {
   try {
     std::size_t used = 0;
     const double v = std::stod(text, &used);
-    if (used == text.size()) return v;
+    if (used == text.size() && std::isfinite(v)) return v;
   } catch (const std::exception&) {
   }
-  throw UsageError(option + ": '" + text + "' is not a number");
+  throw UsageError(option + ": '" + text + "' is not a finite number");
 }
 
 inline int toInt(const std::string& option, const std::string& text) {
