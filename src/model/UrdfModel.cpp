@@ -8,6 +8,7 @@
 #include <unistd.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -37,6 +38,11 @@ using V3 = Eigen::Vector3d;
 
 constexpr std::size_t kMaxUrdfBytes = std::size_t{64} << 20;  // largest URDF file read
 constexpr std::size_t kMaxUrdfDepth = 100;                     // deepest element nesting accepted
+// Bounds of a physical robot, so that no product of the loader or the dynamics overflows (a finite
+// origin of 1e308 m gave NaN torques); the messages quote them.
+constexpr double kMaxLength = 1e6;    // largest coordinate of a joint's or inertial's origin [m]
+constexpr double kMaxMass = 1e9;      // largest mass of a link's <inertial> [kg]
+constexpr double kMaxInertia = 1e12;  // largest magnitude of an inertia entry [kg m^2]
 
 Transform toTransform(const urdf::Pose& p) {
   Transform t = Transform::unit();
@@ -98,6 +104,13 @@ Eigen::Matrix3d axisRotation(const V3& z) {
   R.col(1) = z.cross(x);
   R.col(2) = z;
   return R;
+}
+
+// "%g" of a number.
+std::string shortNumber(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
 }
 
 // At most this much of a name is quoted in a message.
@@ -193,8 +206,10 @@ bool finiteAttribute(const TiXmlElement* e, const char* name, double& value) {
   return ec == std::errc() && ptr == t.data() + t.size() && std::isfinite(value);
 }
 
-// An optional attribute of three numbers ("x y z"): absent, or three finite numbers.
-bool finiteTriple(const TiXmlElement* e, const char* name) {
+// An optional attribute of three numbers ("x y z"): absent, or three finite numbers. `largest`
+// (if not null) receives the largest magnitude of the three (0 if absent).
+bool finiteTriple(const TiXmlElement* e, const char* name, double* largest = nullptr) {
+  if (largest) *largest = 0;
   const char* text = e ? e->Attribute(name) : nullptr;
   if (!text) return true;
   const std::string t(text);
@@ -208,6 +223,7 @@ bool finiteTriple(const TiXmlElement* e, const char* name) {
     double v = 0;
     const auto [ptr, ec] = std::from_chars(begin, t.data() + end, v);
     if (ec != std::errc() || ptr != t.data() + end || !std::isfinite(v)) return false;
+    if (largest) *largest = std::max(*largest, std::abs(v));
     ++count;
     i = end;
   }
@@ -216,6 +232,10 @@ bool finiteTriple(const TiXmlElement* e, const char* name) {
 
 // Checks every link's <inertial> in the XML itself: urdfdom drops an inertial it cannot parse
 // (mass="nan", a missing inertia attribute) with a message on stderr and loads a massless link.
+// Numbers beyond kMaxLength, kMaxMass or kMaxInertia, and an inertia that is not positive
+// semi-definite (a negative principal moment: the mass matrix would lose its positive diagonal),
+// are refused as well. The triangle inequality of the principal moments is not enforced: real
+// descriptions break it slightly (the published Puma 560 does; see physicalModel()).
 void checkInertials(const TiXmlElement* robot, const std::string& fileName) {
   for (const TiXmlElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link")) {
     const TiXmlElement* inertial = link->FirstChildElement("inertial");
@@ -234,22 +254,38 @@ void checkInertials(const TiXmlElement* robot, const std::string& fileName) {
     for (const char* name : {"xyz", "rpy"})
       if (!finiteTriple(origin, name))
         throw UrdfError(where + "origin " + name + " " + quoted(origin, name) + " is not three finite numbers");
+    double farthest = 0;
+    finiteTriple(origin, "xyz", &farthest);
+    if (farthest > kMaxLength)
+      throw UrdfError(where + "origin xyz " + quoted(origin, "xyz") + " has a coordinate larger than 1e6 m in magnitude");
     const TiXmlElement* mass = inertial->FirstChildElement("mass");
     double m = 0;
     if (!finiteAttribute(mass, "value", m))
       throw UrdfError(where + "mass value is not a finite number (" + quoted(mass, "value") + ")");
     if (m < 0) throw UrdfError(where + "mass " + quoted(mass, "value") + " is negative");
+    if (m > kMaxMass) throw UrdfError(where + "mass " + quoted(mass, "value") + " is larger than 1e9 kg");
     const TiXmlElement* inertia = inertial->FirstChildElement("inertia");
+    double v[6] = {};  // ixx, ixy, ixz, iyy, iyz, izz
+    int k = 0;
     for (const char* name : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}) {
-      double v = 0;
-      if (!finiteAttribute(inertia, name, v))
+      if (!finiteAttribute(inertia, name, v[k]))
         throw UrdfError(where + "inertia " + name + " is not a finite number (" + quoted(inertia, name) + ")");
+      if (std::abs(v[k]) > kMaxInertia)
+        throw UrdfError(where + "inertia " + name + " " + quoted(inertia, name) + " is larger than 1e12 kg m^2 in magnitude");
+      ++k;
     }
+    Eigen::Matrix3d I;
+    I << v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5];
+    const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I, Eigen::EigenvaluesOnly).eigenvalues()(0);
+    if (smallest < -1e-9 * (1 + I.cwiseAbs().maxCoeff()))
+      throw UrdfError(where + "inertia is not positive semi-definite (smallest eigenvalue " + shortNumber(smallest) +
+                      " kg m^2)");
   }
 }
 
 // Checks the numbers of every joint in the XML itself: urdfdom refuses a joint whose <limit> holds
-// `nan` with "not a valid URDF document", naming neither the joint nor the value.
+// `nan` with "not a valid URDF document", naming neither the joint nor the value. An origin
+// farther than kMaxLength is refused too.
 void checkJointNumbers(const TiXmlElement* robot, const std::string& fileName) {
   for (const TiXmlElement* joint = robot->FirstChildElement("joint"); joint; joint = joint->NextSiblingElement("joint")) {
     const char* nameAttribute = joint->Attribute("name");
@@ -266,6 +302,11 @@ void checkJointNumbers(const TiXmlElement* robot, const std::string& fileName) {
         if (e && !finiteTriple(e, name))
           throw UrdfError(where + element + "> " + name + " " + quoted(e, name) + " is not three finite numbers");
     }
+    const TiXmlElement* origin = joint->FirstChildElement("origin");
+    double farthest = 0;
+    finiteTriple(origin, "xyz", &farthest);
+    if (farthest > kMaxLength)
+      throw UrdfError(where + "origin> xyz " + quoted(origin, "xyz") + " has a coordinate larger than 1e6 m in magnitude");
     const std::pair<const char*, std::vector<const char*>> numbers[] = {
         {"limit", {"lower", "upper", "effort", "velocity"}}, {"dynamics", {"damping", "friction"}}, {"mimic", {"multiplier", "offset"}}};
     for (const auto& [element, names] : numbers) {
@@ -442,13 +483,6 @@ bool looksLikeGripper(std::string name) {
 }
 
 bool isGripperJoint(const urdf::Joint& j) { return looksLikeGripper(j.name) || looksLikeGripper(j.child_link_name); }
-
-// "%g" of a number.
-std::string shortNumber(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", x);
-  return buf;
-}
 
 // UrdfOptions::offChainPositions checked against the description and in radians and metres: each
 // name a revolute, continuous or prismatic joint off the chain (`chainLinks`: the child links of
@@ -807,6 +841,11 @@ std::unique_ptr<ManipulatorModel> loadUrdfString(const std::string& text, const 
       for (const auto& [what, value] : {std::pair<const char*, double>{"lower", j->limits->lower}, {"upper", j->limits->upper},
                                         {"effort", j->limits->effort}, {"velocity", j->limits->velocity}})
         if (!std::isfinite(value)) throw UrdfError(joint + ": <limit> " + what + " is not a finite number");
+      // A negative speed or torque bound is no bound at all. Zero is "not given" (urdfdom refuses
+      // a <limit> without effort or velocity; tools write 0 as a placeholder): the
+      // ManipulatorModel default stays (3 rad/s or m/s, 100 N m or N; not scaled below).
+      for (const auto& [what, value] : {std::pair<const char*, double>{"effort", j->limits->effort}, {"velocity", j->limits->velocity}})
+        if (value < 0) throw UrdfError(joint + ": <limit> " + what + " " + shortNumber(value) + " is negative");
     }
     if (j->dynamics && (!std::isfinite(j->dynamics->damping) || !std::isfinite(j->dynamics->friction)))
       throw UrdfError(joint + ": <dynamics> damping or friction is not a finite number");

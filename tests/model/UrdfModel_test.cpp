@@ -714,6 +714,91 @@ TEST_F(UrdfInputTest, NonFiniteJointNumbersAreRefusedWithTheJointName) {
   EXPECT_EQ(message(f), "no error");
 }
 
+// A negative <limit> velocity or effort was replaced by the ManipulatorModel default (3 rad/s,
+// 100 N m) without a word; it is refused naming the file and the joint. Zero is "not given" (a
+// placeholder some tools write): the default, unscaled by velocityLimitScale.
+TEST_F(UrdfInputTest, NegativeVelocityAndEffortLimitsAreRefusedWithTheJointName) {
+  auto arm = [&](const std::string& type, const std::string& limit) {
+    return write("arm.urdf", "<robot name=\"arm\"><link name=\"base\"/><link name=\"upper\"/><joint name=\"shoulder\" "
+                             "type=\"" + type + "\"><parent link=\"base\"/><child link=\"upper\"/><axis xyz=\"0 0 1\"/>" +
+                                 limit + "</joint></robot>");
+  };
+  std::string f = arm("revolute", "<limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"-2\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <limit> velocity -2 is negative");
+  f = arm("prismatic", "<limit lower=\"0\" upper=\"0.5\" effort=\"-50\" velocity=\"0.3\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <limit> effort -50 is negative");
+  f = arm("continuous", "<limit effort=\"10\" velocity=\"-0.5\"/>");
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <limit> velocity -0.5 is negative");
+  f = arm("revolute", "<limit lower=\"-1\" upper=\"1\" effort=\"0\" velocity=\"0\"/>");
+  UrdfOptions slower;
+  slower.velocityLimitScale = 0.8;
+  ASSERT_EQ(message(f, slower), "no error");
+  const std::unique_ptr<ManipulatorModel> model = loadUrdf(f, slower);
+  EXPECT_EQ(model->getVelocityLimit()(0), 3.0);
+  EXPECT_EQ(model->getTorqueLimit()(0), 100.0);
+}
+
+// An inertia that is not positive semi-definite (a negative principal moment) gave a mass matrix
+// with negative diagonal entries and confusing errors later on; it is refused naming the file and
+// the link. The triangle inequality is not enforced (real descriptions break it slightly, as the
+// published Puma 560 does), and a zero inertia (a point mass, a massless link) loads.
+TEST_F(UrdfInputTest, InertiasThatAreNotPositiveSemiDefiniteAreRefusedWithTheLinkName) {
+  auto arm = [&](const std::string& mass, const std::string& inertia) {
+    return write("arm.urdf", "<robot name=\"arm\"><link name=\"base\"/><link name=\"upper\"><inertial><mass value=\"" +
+                                 mass + "\"/><inertia " + inertia + "/></inertial></link>" +
+                                 joint("j", "revolute", "base", "upper") + "</robot>");
+  };
+  std::string f = arm("2", "ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"-0.5\" iyz=\"0\" izz=\"1\"");
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> inertia is not positive semi-definite (smallest eigenvalue "
+                            "-0.5 kg m^2)");
+  f = arm("2", "ixx=\"0.1\" ixy=\"5\" ixz=\"5\" iyy=\"0.1\" iyz=\"5\" izz=\"0.1\"");
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> inertia is not positive semi-definite (smallest eigenvalue "
+                            "-4.9 kg m^2)");
+  for (const char* inertia : {"ixx=\"0.066\" ixy=\"0\" ixz=\"0\" iyy=\"0.086\" iyz=\"0\" izz=\"0.0125\"",  // Puma link 3
+                              "ixx=\"0\" ixy=\"0\" ixz=\"0\" iyy=\"0\" iyz=\"0\" izz=\"0\"",
+                              "ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"-1e-12\" iyz=\"0\" izz=\"0.01\""}) {  // rounding
+    f = arm("2", inertia);
+    EXPECT_EQ(message(f), "no error") << inertia;
+  }
+  f = arm("0", "ixx=\"0\" ixy=\"0\" ixz=\"0\" iyy=\"0\" iyz=\"0\" izz=\"0\"");
+  EXPECT_EQ(message(f), "no error");
+}
+
+// Finite numbers too large for a robot gave NaN torques with exit status 0 (rp-model gravity
+// printed null): lengths beyond 1e6 m, masses above 1e9 kg and inertias above 1e12 kg m^2 are
+// refused naming the file, the joint or link and the element.
+TEST_F(UrdfInputTest, HugeLengthsMassesAndInertiasAreRefusedWithTheElement) {
+  auto arm = [&](const std::string& origin, const std::string& inertialXml) {
+    return write("arm.urdf", "<robot name=\"arm\"><link name=\"base\"/><link name=\"upper\">" + inertialXml +
+                                 "</link><joint name=\"shoulder\" type=\"revolute\"><parent link=\"base\"/><child "
+                                 "link=\"upper\"/>" + origin + "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" "
+                                 "effort=\"1\" velocity=\"1\"/></joint></robot>");
+  };
+  std::string f = arm("<origin xyz=\"0 0 1e308\"/>", inertial("1"));
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <origin> xyz '0 0 1e308' has a coordinate larger than 1e6 m in magnitude");
+  f = arm("", inertial("1", "1", "<origin xyz=\"1e200 0 0\"/>"));
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> origin xyz '1e200 0 0' has a coordinate larger than 1e6 m in "
+                            "magnitude");
+  f = arm("", inertial("2e9"));
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> mass '2e9' is larger than 1e9 kg");
+  f = arm("", inertial("1", "1e13"));
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> inertia ixx '1e13' is larger than 1e12 kg m^2 in magnitude");
+  f = arm("", "<inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"-2e12\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial>");
+  EXPECT_EQ(message(f), f + ": link 'upper': <inertial> inertia ixy '-2e12' is larger than 1e12 kg m^2 in magnitude");
+  // At the bounds the arm loads and its dynamics are finite.
+  f = arm("<origin xyz=\"-1e6 0 1e6\"/>",
+          "<inertial><origin xyz=\"1e6 0 0\"/><mass value=\"1e9\"/><inertia ixx=\"1e12\" ixy=\"0\" ixz=\"0\" iyy=\"1e12\" "
+          "iyz=\"0\" izz=\"1e12\"/></inertial>");
+  ASSERT_EQ(message(f), "no error");
+  const std::unique_ptr<ManipulatorModel> model = loadUrdf(f);
+  ManipulatorData data(*model);
+  JointVector q(1), qd(1);
+  q(0) = 0.5;
+  qd(0) = 1;
+  EXPECT_TRUE(massMatrix(*model, data, q).allFinite());
+  EXPECT_TRUE(inverseDynamics(*model, data, q, qd, qd).allFinite());
+}
+
 TEST_F(UrdfInputTest, SpecialDeepAndHugeFilesAreRefused) {
   EXPECT_EQ(message("/dev/zero"), "/dev/zero: cannot read the file: it is not a regular file");
   const std::string fifo = (dir_ / "arm.urdf").string();

@@ -67,7 +67,7 @@ struct UrdfOptions {
   /// The joints' velocity limits are the `<limit velocity>` of the file times this (a positive,
   /// finite number; UrdfOptionError otherwise): a client that plans for an arm it does not drive
   /// itself (RemoteManipulator) keeps a reserve for the arm's own controller. Velocities the file
-  /// does not give keep the ManipulatorModel default.
+  /// does not give (no `<limit>`, or `velocity="0"`) keep the ManipulatorModel default, unscaled.
   double velocityLimitScale = 1.0;
 };
 
@@ -89,21 +89,21 @@ struct UrdfOptions {
 /// link in the last link frame, so forward kinematics equals the URDF's for every joint vector
 /// and joint values keep the URDF's zero and sign (a prismatic joint's value in metres along its
 /// axis). Joint and link names are the URDF's. Limits come from `<limit>` (continuous joints get
-/// +-2 pi; a missing effort or velocity the ManipulatorModel defaults); `<dynamics damping
-/// friction>` become viscous and Coulomb friction. Before returning, the model's forward
-/// kinematics is compared with the description's at the zero configuration and at four others
-/// spread over the joint ranges.
+/// +-2 pi; an effort or velocity of 0, or none, the ManipulatorModel defaults 100 N m and 3 rad/s);
+/// `<dynamics damping friction>` become viscous and Coulomb friction. Before returning, the
+/// model's forward kinematics is compared with the description's at the zero configuration and
+/// at four others spread over the joint ranges.
 /// @param[in] fileName  path of the URDF file
 /// @param[in] options   tip link and whether dynamics are required
 /// @return the model, named after the robot
-/// @throws UrdfError naming the file for: a missing or unreadable file, malformed XML (with the
-///         line and column: `FILE:LINE:COLUMN: ...`) or URDF (with urdfdom's own errors, which
-///         name the joint or link; they no longer go to stderr), a
-///         floating or planar joint in the chain, an unknown tip, a branching robot
-///         without a tip, no movable joint, a number that is not finite (naming the joint or
-///         link), a mimic joint naming a missing joint (or mimics in a circle), a mimic joint on
-///         the chain following a joint off it, and (with requireDynamics) a moving link without inertial
-///         data; UrdfOptionError (a UrdfError) for a bad UrdfOptions::offChainPositions entry
+/// @throws UrdfError naming the file for: a missing or unreadable file, malformed XML (`FILE:LINE:COLUMN: ...`)
+///         or URDF (urdfdom's own errors, naming the joint or link), a floating or planar joint in the chain,
+///         an unknown tip, a branching robot without a tip, no movable joint; and naming the joint or link: a
+///         number that is not finite or beyond the bounds of docs/models.md, a negative `<limit>` effort or
+///         velocity or a lower limit above the upper on the chain, an inertia that is not positive semi-definite,
+///         a mimic joint naming a missing joint (or mimics in a circle) or on the chain following one off it, and
+///         (with requireDynamics) a moving link without inertial data; UrdfOptionError (a UrdfError) for a bad
+///         UrdfOptions::offChainPositions entry
 /// Real-time safe: no.
 std::unique_ptr<ManipulatorModel> loadUrdf(const std::string& fileName, const UrdfOptions& options = UrdfOptions());
 
