@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <mutex>
 #include <stdexcept>
@@ -694,6 +695,17 @@ std::unique_ptr<ManipulatorSimulation> makeSimulation(const ManipulatorModel& no
       q = sim->getTruePosition();
     }
     if (qd.size() == 0) qd = JointVector::Zero(n);
+    // A start beyond a velocity limit is a shutdown in the first cycle (and 1e6 deg/s gave NaN
+    // joints): refused here, at the setting's line, as a start outside the position limits is.
+    for (int i = 0; i < n; ++i)
+      if (std::abs(qd(i)) > nominal.getVelocityLimit()(i)) {
+        char detail[160];
+        std::snprintf(detail, sizeof detail, "simInitialVelocity: joint %d: %g %s is beyond its velocity limit %g %s",
+                      i + 1, qd(i) / (nominal.isPrismatic(i) ? 1e-3 : deg), nominal.isPrismatic(i) ? "mm/s" : "deg/s",
+                      nominal.getVelocityLimit()(i) / (nominal.isPrismatic(i) ? 1e-3 : deg),
+                      nominal.isPrismatic(i) ? "mm/s" : "deg/s");
+        throw section->errorAt(*section->find("simInitialVelocity"), detail);
+      }
     sim->setState(q, qd);
   }
   return sim;

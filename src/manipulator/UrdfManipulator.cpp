@@ -63,7 +63,12 @@ std::unique_ptr<ManipulatorModel> loadFor(const ConfigSection* section, const st
                                           const std::string& urdfFile, const std::string& tipLink,
                                           const Transform& base) {
   const auto [file, tip] = resolve(section, urdfFile, tipLink);
-  if (file.empty()) throw std::invalid_argument("UrdfManipulator '" + name + "': no URDF file (rp.cfg setting 'urdf')");
+  if (file.empty()) {
+    if (section != nullptr)
+      throw ConfigError(section->fileName(), section->line(),
+                        "[" + section->name() + "] (class UrdfManipulator) needs 'urdf FILE', the arm's description");
+    throw std::invalid_argument("UrdfManipulator '" + name + "': no URDF file (rp.cfg setting 'urdf')");
+  }
   UrdfOptions options;
   options.tip = tip;
   options.requireDynamics = true;
@@ -78,6 +83,12 @@ std::unique_ptr<ManipulatorModel> loadFor(const ConfigSection* section, const st
     const ConfigSetting* setting = section != nullptr ? section->find("offChainPositions") : nullptr;
     if (setting == nullptr) throw;
     throw section->errorAt(*setting, "offChainPositions: " + e.problem() + " in " + file);
+  } catch (const UrdfError& e) {
+    // A file rp.cfg names: that line first, then the loader's own error (naming the URDF file and
+    // the joint or link), so a user of rp.cfg sees where the file came from.
+    const ConfigSetting* setting = section != nullptr ? section->find("urdf") : nullptr;
+    if (setting == nullptr) throw;
+    throw UrdfError(section->fileName() + ":" + std::to_string(setting->line) + ": urdf: " + e.what());
   }
   for (const std::string& note : notes) std::cerr << "rp: UrdfManipulator '" << name << "': " << note << std::endl;
   // Place the arm where the object stands: the object's pose times the URDF's own base frame.

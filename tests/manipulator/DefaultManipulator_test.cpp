@@ -867,8 +867,30 @@ TEST_F(ManipulatorTest, AnyArmFromAUrdfFileIsSimulatedAndHeld) {
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(q(i), 0.0, 1e-6) << "held under gravity compensation, joint " << i + 1;
   EXPECT_EQ(arm->getErrorCode(), 0) << arm->getErrorStatus().message;
   om.deleteObject(arm);
+  // Errors name rp.cfg's line as well as the URDF file (they used to name the URDF file only).
   RoboticPlatform::setConfiguration(Configuration::parse("[arm]\nclass UrdfManipulator\nurdf nosuchfile.urdf\n", "rp.cfg"));
-  EXPECT_THROW(om.createDerivedObject<Manipulator>("arm"), UrdfError);
+  try {
+    om.createDerivedObject<Manipulator>("arm");
+    ADD_FAILURE() << "a missing URDF file was accepted";
+  } catch (const UrdfError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("rp.cfg:3: urdf: nosuchfile.urdf: ", 0), 0u) << e.what();
+  }
+  RoboticPlatform::setConfiguration(Configuration::parse(
+      "[arm]\nclass UrdfManipulator\nurdf " RP_TEST_MODEL_DATA "/test_arm.urdf\ntip nolink\n", "rp.cfg"));
+  try {
+    om.createDerivedObject<Manipulator>("arm");
+    ADD_FAILURE() << "an unknown tip was accepted";
+  } catch (const UrdfError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("rp.cfg:3: urdf: ", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("nolink"), std::string::npos) << e.what();
+  }
+  RoboticPlatform::setConfiguration(Configuration::parse("\n[arm]\nclass UrdfManipulator\n", "rp.cfg"));
+  try {
+    om.createDerivedObject<Manipulator>("arm");
+    ADD_FAILURE() << "a UrdfManipulator without a file was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "rp.cfg:2: [arm] (class UrdfManipulator) needs 'urdf FILE', the arm's description");
+  }
 }
 
 // Issue 20: rp.cfg's offChainPositions puts the jaw where it is lumped into the arm (deg, as

@@ -562,6 +562,18 @@ TEST(SimulationPlant, SwitchesSensorsAndInitialState) {
     }
   }
   EXPECT_NE(sim->getPosition()(5), sim->getTruePosition()(5));
+  // A start beyond a joint's velocity limit is refused at the setting's line (it used to be taken,
+  // and the arm shut down in its first cycle; 1e6 deg/s gave NaN joints).
+  for (const char* v : {"1000 0 0 0 0 0", "0 0 0 0 0 -1000000"}) {
+    const Configuration fast = Configuration::parse(std::string("[puma]\nclass Puma560\nsimInitialVelocity ") + v + "\n", "rp.cfg");
+    try {
+      (void)makeSimulation(nominal, &section(fast));
+      ADD_FAILURE() << v << " was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("rp.cfg:3: simInitialVelocity: joint ", 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find("deg/s is beyond its velocity limit"), std::string::npos) << e.what();
+    }
+  }
 }
 
 // simEncoderOffset: the readings are the plant's position plus the offset (degrees in rp.cfg),
