@@ -66,6 +66,7 @@ struct RemoteManipulator::Impl {
   RemoteManipulatorOptions options;
   std::string nameSpace, object;  // the remote bridge's namespace and the arm's ROS name
   std::string label;              // "NS/OBJECT" for messages
+  std::string badSample;          // the first joint_states sample refused (a value not finite), or empty
   bool leased = false;  // the DDS domain (ros2detail::acquireDomain())
   dds_entity_t participant = 0;
   dds_entity_t jointStates = 0, state = 0, description = 0, trajectory = 0;
@@ -176,6 +177,29 @@ bool RemoteManipulator::Impl::takeJointStates() {
         column[static_cast<std::size_t>(i)] = c;
       }
     }
+    // A value that is not a number is no state of an arm: the sample is refused (not stored) and
+    // named once; the reader thread makes it a fault, connect() an error.
+    for (int i = 0; i < n && ours; ++i) {
+      const auto c = static_cast<uint32_t>(column[static_cast<std::size_t>(i)]);
+      const struct {
+        const char* field;
+        bool given;
+        double value;
+      } values[] = {{"position", true, js.position._buffer[c]},
+                    {"velocity", js.velocity._length == js.name._length, js.velocity._length == js.name._length ? js.velocity._buffer[c] : 0.0},
+                    {"effort", js.effort._length == js.name._length, js.effort._length == js.name._length ? js.effort._buffer[c] : 0.0}};
+      for (const auto& v : values) {
+        if (!v.given || std::isfinite(v.value)) continue;
+        if (badSample.empty()) {
+          char text[320];
+          std::snprintf(text, sizeof text, "the remote arm %.120s sent joint_states with %.40s of joint '%.60s' %g: not a finite number",
+                        label.c_str(), v.field, jointNames[static_cast<std::size_t>(i)].c_str(), v.value);
+          badSample = text;
+        }
+        ours = false;
+        break;
+      }
+    }
     if (ours) {
       const double receipt = 1e-9 * static_cast<double>(ros2detail::wallNanoseconds());
       const double stamp = js.header.stamp.sec + 1e-9 * js.header.stamp.nanosec;
@@ -265,6 +289,7 @@ void RemoteManipulator::Impl::read(const std::function<void(const std::string&)>
     } catch (const std::exception& e) {
       message = std::string("the remote arm's state: ") + e.what();
     }
+    if (message.empty()) message = badSample;
     if (faulted.load()) continue;  // raiseFault() takes the first fault only
     if (message.empty() && std::chrono::steady_clock::now() - lastReceipt > timeout) {
       char text[160];
@@ -438,6 +463,7 @@ void RemoteManipulator::connect() {
   bool joints = false;
   while (!joints || !d.haveBaseline) {
     joints = d.takeJointStates() || joints;
+    if (!d.badSample.empty()) throw std::runtime_error(d.badSample);
     const std::string fault = d.takeStates();
     if (!fault.empty()) throw std::runtime_error(fault);
     if (joints && d.haveBaseline) break;

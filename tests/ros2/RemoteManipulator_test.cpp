@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -22,6 +23,9 @@
 #include "rp/model/Kinematics.hpp"
 #include "rp/model/ManipulatorData.hpp"
 #include "rp/model/Puma560Model.hpp"
+#include "rp/model/UrdfExport.hpp"
+#include "sensor_msgs.h"
+#include "std_msgs.h"
 
 namespace rp::test {
 namespace {
@@ -209,6 +213,105 @@ TEST_F(RemoteManipulatorTest, ReportsLatencyLossAndTheRemoteRefusal) {
               static_cast<unsigned long long>(s.samples), s.period, static_cast<unsigned long long>(s.gaps),
               static_cast<unsigned long long>(s.missing), 1e3 * s.latencyMedian, 1e3 * s.latencyP99);
   m.clearTrajectoryGenerator();
+}
+
+// A remote arm faked here (its description, state and joint_states written by this test) whose
+// joint_states carry a value that is not a number. Such a sample is no state of an arm: it is never
+// taken (it used to become the arm's position, the start of the next motion). While connecting,
+// it is the constructor's error; once connected, a fault that shuts the system down; both name
+// the field and the joint.
+TEST_F(RemoteManipulatorTest, AJointStateThatIsNotANumberIsRefusedNamingTheJoint) {
+  participant_ = dds_create_participant(static_cast<dds_domainid_t>(options_.domain), nullptr, nullptr);
+  ASSERT_GT(participant_, 0);
+  auto topicWriter = [&](const dds_topic_descriptor_t& desc, const std::string& topic, bool latched) {
+    const std::string name = "rt/" + ns_ + "/" + topic;
+    const dds_entity_t t = dds_create_topic(participant_, &desc, name.c_str(), nullptr, nullptr);
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_durability(qos, latched ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, latched ? 1 : 10);
+    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+    dds_qset_data_representation(qos, 1, &xcdr1);
+    const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
+    dds_delete_qos(qos);
+    EXPECT_GT(w, 0) << name;
+    return w;
+  };
+  const dds_entity_t description = topicWriter(std_msgs_msg_dds__String__desc, "arm/robot_description", true);
+  const dds_entity_t state = topicWriter(std_msgs_msg_dds__String__desc, "arm/state", false);
+  const dds_entity_t joints = topicWriter(sensor_msgs_msg_dds__JointState__desc, "joint_states", false);
+  const std::string urdf = toUrdf(Puma560Model());
+  std_msgs_msg_dds__String_ d{};
+  d.data = const_cast<char*>(urdf.c_str());
+  ASSERT_EQ(dds_write(description, &d), 0);
+
+  // The fake arm: at home, powered, every 2 ms; `bad` puts a NaN into joint 2's field `field`
+  // (0 position, 1 velocity, 2 effort) or nowhere (-1).
+  std::atomic<int> bad{-1};
+  std::atomic<bool> stop{false};
+  std::thread remote([&] {
+    const Puma560Model puma;
+    std::vector<std::string> names;
+    for (int i = 0; i < 6; ++i) names.push_back("arm_joint" + std::to_string(i + 1));
+    std::vector<char*> namePointers;
+    for (std::string& n : names) namePointers.push_back(n.data());
+    std_msgs_msg_dds__String_ s{};
+    s.data = const_cast<char*>(R"({"power":true,"errorCode":0,"shutdown":false,"trajectoriesRefused":0})");
+    while (!stop.load()) {
+      double q[6], qd[6] = {0, 0, 0, 0, 0, 0}, tau[6] = {0, 0, 0, 0, 0, 0};
+      for (int i = 0; i < 6; ++i) q[i] = puma.getHomePosition()(i);
+      double* fields[3] = {q, qd, tau};
+      if (const int f = bad.load(); f >= 0) fields[f][1] = std::nan("");
+      const std::int64_t now =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+      sensor_msgs_msg_dds__JointState_ js{};
+      js.header.stamp.sec = static_cast<int32_t>(now / 1000000000);
+      js.header.stamp.nanosec = static_cast<uint32_t>(now % 1000000000);
+      js.header.frame_id = const_cast<char*>("");
+      js.name = {6, 6, namePointers.data(), false};
+      js.position = {6, 6, q, false};
+      js.velocity = {6, 6, qd, false};
+      js.effort = {6, 6, tau, false};
+      dds_write(joints, &js);
+      dds_write(state, &s);
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  });
+  struct Join {
+    std::atomic<bool>& stop;
+    std::thread& t;
+    ~Join() {
+      stop = true;
+      t.join();
+    }
+  } join{stop, remote};
+  configure("[leader]\nclass RemoteManipulator\nremote " + ns_ + "/arm\ndomain " + std::to_string(options_.domain) +
+            "\nconnectTimeout 30\n");
+
+  bad = 0;  // from the start: the constructor refuses the arm
+  try {
+    RemoteManipulator m("leader");
+    ADD_FAILURE() << "connected to an arm whose position is not a number";
+  } catch (const std::exception& e) {
+    EXPECT_TRUE(contains(e.what(), "sent joint_states with position of joint 'arm_joint2' nan: not a finite number"))
+        << e.what();
+  }
+
+  bad = -1;  // connected to a sane arm, then a velocity that is not a number: a fault
+  RemoteManipulator m("leader");
+  ASSERT_EQ(m.getErrorCode(), 0);
+  const JointVector before = m.getJointPosition();
+  bad = 1;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!ObjectManager::isShutdownRequested() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_TRUE(ObjectManager::isShutdownRequested());
+  EXPECT_NE(m.getErrorCode(), 0);
+  EXPECT_TRUE(contains(m.getErrorStatus().message, "sent joint_states with velocity of joint 'arm_joint2' nan"))
+      << m.getErrorStatus().message;
+  EXPECT_TRUE(m.getJointPosition().allFinite());
+  EXPECT_TRUE(m.getJointVelocity().allFinite()) << "the refused sample was taken";
+  EXPECT_LT((m.getJointPosition() - before).cwiseAbs().maxCoeff(), 1e-12);
 }
 
 TEST_F(RemoteManipulatorTest, SettingsErrorsNameTheFileAndLine) {
