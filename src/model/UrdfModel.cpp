@@ -724,7 +724,15 @@ std::unique_ptr<ManipulatorModel> loadUrdfString(const std::string& text, const 
       j = robot->getJoint(j->mimic->joint_name).get();
     }
     double v = 0;
-    if (j->limits && j->type != urdf::Joint::CONTINUOUS) v = std::clamp(0.0, j->limits->lower, j->limits->upper);
+    if (j->limits && j->type != urdf::Joint::CONTINUOUS) {
+      // (std::clamp with lower above upper is undefined behaviour, not just a wrong value.)
+      if (!(j->limits->lower <= j->limits->upper)) {
+        char range[96];
+        std::snprintf(range, sizeof range, "lower %g is above upper %g", j->limits->lower, j->limits->upper);
+        throw UrdfError(fileName + ": joint '" + excerpt(j->name) + "': <limit> " + range);
+      }
+      v = std::clamp(0.0, j->limits->lower, j->limits->upper);
+    }
     return multiplier * v + offset;
   };
   // A link's inertia and that of everything hanging on it off the chain: fixed (a camera) or

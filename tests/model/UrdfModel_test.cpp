@@ -644,6 +644,19 @@ TEST_F(UrdfInputTest, LimitsTheModelRefusesNameTheFileAndJoint) {
                               "<parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/>"
                               "<limit lower=\"1\" upper=\"-1\" effort=\"1\" velocity=\"1\"/></joint></robot>");
   EXPECT_EQ(message(f), f + ": joint 'j': <limit> lower 1 is above upper -1");
+  // The same on a moving joint off the chain (a finger lumped into the arm's last link): it used
+  // to go to std::clamp(0, 1, -1), which is undefined behaviour.
+  const std::string g = write("offchain.urdf",
+                              "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/>"
+                              "<link name=\"c\"><inertial><mass value=\"1\"/>"
+                              "<inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link>" +
+                                  joint("j", "revolute", "a", "b") +
+                                  "<joint name=\"finger\" type=\"revolute\"><parent link=\"b\"/><child link=\"c\"/>"
+                                  "<axis xyz=\"0 0 1\"/><limit lower=\"1\" upper=\"-1\" effort=\"1\" velocity=\"1\"/></joint>"
+                                  "</robot>");
+  UrdfOptions tipB;
+  tipB.tip = "b";
+  EXPECT_EQ(message(g, tipB), g + ": joint 'finger': <limit> lower 1 is above upper -1");
 }
 
 TEST_F(UrdfInputTest, LongChainsOfFixedLinksAreWalkedWithoutRecursion) {
