@@ -61,6 +61,10 @@ inline Manipulator* startUtility(const std::string& program, const std::string& 
     std::cerr << program << ": unexpected argument '" << argv[2] << "' (usage: " << program << " [-config FILE] [NAME])\n";
     return nullptr;
   }
+  if (argc == 2 && argv[1][0] == '-') {  // a --long option the platform left: not a section name
+    std::cerr << program << ": unknown option '" << argv[1] << "' (usage: " << program << " [-config FILE] [NAME])\n";
+    return nullptr;
+  }
   try {
     return chooseManipulator(name, own);
   } catch (const std::exception& e) {

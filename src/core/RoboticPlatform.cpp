@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -99,6 +100,15 @@ std::string RoboticPlatform::usage() {
 std::vector<std::string> RoboticPlatform::parseCommandLine(const std::vector<std::string>& args) {
   std::vector<std::string> rest;
   auto& s = state();
+  // A switch with its opposite is a slip, not "the last one wins" (-sim -nosim drove the
+  // hardware): refused before any switch takes effect.
+  const auto end = std::find(args.begin(), args.end(), "--");
+  for (const auto& [on, off] : {std::pair<const char*, const char*>{"-sim", "-nosim"}, {"-gui", "-nogui"}}) {
+    const auto a = std::find(args.begin(), end, on), b = std::find(args.begin(), end, off);
+    if (a != end && b != end)
+      throw std::invalid_argument("switches '" + std::string(a < b ? on : off) + "' and '" + (a < b ? off : on) +
+                                  "' contradict each other");
+  }
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--") {
@@ -134,7 +144,8 @@ std::vector<std::string> RoboticPlatform::parseCommandLine(const std::vector<std
       std::size_t used = 0;
       int port = -1;
       try {
-        port = std::stoi(v, &used);
+        // Digits only: std::stoi also takes " 80" and "+80".
+        if (v.find_first_not_of("0123456789") == std::string::npos && v.size() <= 5) port = std::stoi(v, &used);
       } catch (const std::exception&) {
         used = 0;
       }

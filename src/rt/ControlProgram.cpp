@@ -48,6 +48,14 @@ void ensureShutdownWatcher();
 
 namespace {
 
+// A number in a message, as short as its value allows ("11", "1e+300"; std::to_string printed
+// 1e300 with 300 digits and 0.1 as 0.100000).
+std::string shortNumber(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.10g", v);
+  return text;
+}
+
 constexpr std::size_t kBins = 10000;  // 1 µs histogram bins; the last one holds everything above
 
 // Durations in nanoseconds: min, max, sum and a 1 µs histogram, written by one thread.
@@ -312,8 +320,8 @@ struct ControlProgram::Impl {
   void checkRange(const Param& p, const std::vector<double>& values) const {
     for (double v : values)
       if (!(v >= p.info.min && v <= p.info.max))
-        throw std::out_of_range("ControlProgram " + name + ": parameter '" + p.info.name + "' = " + std::to_string(v) +
-                                " is outside [" + std::to_string(p.info.min) + ", " + std::to_string(p.info.max) + "]" +
+        throw std::out_of_range("ControlProgram " + name + ": parameter '" + p.info.name + "' = " + internal::shortNumber(v) +
+                                " is outside [" + internal::shortNumber(p.info.min) + ", " + internal::shortNumber(p.info.max) + "]" +
                                 (p.info.unit.empty() ? "" : " " + p.info.unit));
   }
 
@@ -1409,8 +1417,8 @@ void ControlProgram::registerParameter(const std::string& name, double* target, 
   p->pending.reset(new std::atomic<double>[size]);
   for (std::size_t i = 0; i < size; ++i) {
     if (!(target[i] >= min && target[i] <= max))
-      throw std::invalid_argument("registerParameter: '" + name + "': the current value " + std::to_string(target[i]) +
-                                  " is outside [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+      throw std::invalid_argument("registerParameter: '" + name + "': the current value " + internal::shortNumber(target[i]) +
+                                  " is outside [" + internal::shortNumber(min) + ", " + internal::shortNumber(max) + "]");
     p->pending[i].store(target[i]);
     p->requested.push_back(target[i]);
   }

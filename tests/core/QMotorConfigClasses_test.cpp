@@ -120,8 +120,8 @@ TEST_F(QMotorConfigClasses, ASensorConstructedByTheProgramGetsItsFile) {
   EXPECT_TRUE(sensor.isRunning());
   configure("[filter2]\nclass QmFilteredSensor\nqmotorConfig hand.cfg\n", "cutoff 5000\n");
   EXPECT_EQ(configError([] { FilteredSensor bad("filter2"); }),
-            path("hand.cfg") + ":1: ControlProgram filter2: parameter 'cutoff' = 5000.000000 is outside [0.100000, "
-                               "1000.000000] Hz");
+            path("hand.cfg") + ":1: ControlProgram filter2: parameter 'cutoff' = 5000 is outside [0.1, "
+                               "1000] Hz");
 }
 
 TEST_F(QMotorConfigClasses, AClassThatRunsNoControlProgramRefusesTheFileAtTheRpCfgLine) {

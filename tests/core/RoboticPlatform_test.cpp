@@ -48,6 +48,25 @@ TEST(RoboticPlatform, SwitchErrors) {
     EXPECT_STREQ(e.what(), "switch '-config' needs a value (a file name)");
   }
   EXPECT_THROW(RoboticPlatform::parseCommandLine({"-log"}), std::invalid_argument);
+  // A switch with its opposite (the last used to win: -sim -nosim drove the hardware).
+  for (const auto& [first, second] : std::vector<std::pair<std::string, std::string>>{
+           {"-sim", "-nosim"}, {"-nosim", "-sim"}, {"-gui", "-nogui"}, {"-nogui", "-gui"}}) {
+    try {
+      RoboticPlatform::parseCommandLine({first, second});
+      ADD_FAILURE() << first << " " << second;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()), "switches '" + first + "' and '" + second + "' contradict each other");
+    }
+  }
+  // A port is digits only (std::stoi took " 80" and "+80").
+  for (const char* port : {" 80", "+80", "80 ", "0x50"}) {
+    try {
+      RoboticPlatform::parseCommandLine({"-gui-port", port});
+      ADD_FAILURE() << "'" << port << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("-gui-port"), std::string::npos) << e.what();
+    }
+  }
 }
 
 class InitDeathTest : public ::testing::Test {

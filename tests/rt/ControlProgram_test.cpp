@@ -342,7 +342,7 @@ TEST(ControlProgram, ParameterErrors) {
     r.setParameter("gain", 11.0);
     FAIL();
   } catch (const std::out_of_range& e) {
-    EXPECT_STREQ(e.what(), "ControlProgram p: parameter 'gain' = 11.000000 is outside [0.000000, 10.000000] N/m");
+    EXPECT_STREQ(e.what(), "ControlProgram p: parameter 'gain' = 11 is outside [0, 10] N/m");
   }
   EXPECT_EQ(r.gain, 1.0);
   try {
@@ -381,7 +381,7 @@ TEST(ControlProgram, QMotorConfigFile) {
   EXPECT_EQ(message("gain 1\nkx 1\n"),
             "leader.cfg:2: 'kx' is not a parameter of leader (known: rate, priority, logEvery, logBufferSize, log, gain, kp)");
   EXPECT_EQ(message("gain 12\n"),
-            "leader.cfg:1: ControlProgram leader: parameter 'gain' = 12.000000 is outside [0.000000, 10.000000] N/m");
+            "leader.cfg:1: ControlProgram leader: parameter 'gain' = 12 is outside [0, 10] N/m");
   EXPECT_EQ(message("kp 1 2\n"), "leader.cfg:1: ControlProgram leader: parameter 'kp' needs 3 values, got 2");
   EXPECT_EQ(message("rate 1 2\n"), "leader.cfg:1: 'rate' needs 1 value, got 2");
   EXPECT_EQ(message("log q tau\n"), "leader.cfg:1: 'log': 'tau' is not a log variable of leader (known: x, q)");
