@@ -61,6 +61,7 @@ void watcher() {
       std::lock_guard<std::mutex> lock(reg.doneMutex);
       reg.done = true;
     }
+    reg.shutdownComplete.store(true);
     reg.doneCv.notify_all();
     if (int sig = reg.signalNumber.load()) {
       std::fflush(stderr);  // not stdout: a main thread blocked writing to a full pipe may hold its lock
@@ -283,6 +284,7 @@ void ObjectManager::resetShutdown() {
   auto& reg = internal::registry();
   std::lock_guard<std::mutex> lock(reg.doneMutex);
   reg.done = false;
+  reg.shutdownComplete.store(false);
   reg.reasonReady = false;  // the reason's text stays until the next request writes it
   reg.requested = 0;
 }

@@ -36,6 +36,7 @@ struct Registry {
   std::mutex doneMutex;
   std::condition_variable doneCv;
   bool done = false;
+  std::atomic<bool> shutdownComplete{false};  // `done`, for a signal handler (no lock there)
   std::atomic<double> timeoutSeconds{5.0};
 
   // Global configuration (replaced as a whole).

@@ -50,10 +50,22 @@ SimulatedClock& platformSimulatedClock() {
   return *c;
 }
 
+// SIGINT and SIGTERM: the first starts a system shutdown (the watcher thread ends the process
+// with 128 + the signal once it is complete). Another one while the shutdown brings the arms to
+// rest does not cut it short (`timeout` signals the program and then its process group; a user
+// presses Ctrl-C again): it used to end the process at once, with no hold and no complete log.
+// Once the shutdown is complete (a program that does not end after it), another signal ends the
+// process. SIGKILL always ends it at once; a hardware server's watchdog then switches the outputs off.
 void onSignal(int sig) {
-  signal(sig, SIG_DFL);  // a second signal ends the process at once
   auto& reg = internal::registry();
-  reg.signalNumber.store(sig);
+  int none = 0;
+  if (!reg.signalNumber.compare_exchange_strong(none, sig)) {
+    if (reg.shutdownComplete.load()) _exit(128 + reg.signalNumber.load());
+    static const char note[] = "rp: the system shutdown is still bringing the arms to rest (SIGKILL ends the program at once)\n";
+    const ssize_t ignored = write(STDERR_FILENO, note, sizeof note - 1);
+    (void)ignored;
+    return;
+  }
   ObjectManager::requestSystemShutdown(sig == SIGINT ? "SIGINT received" : "SIGTERM received");
 }
 

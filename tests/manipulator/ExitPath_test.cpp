@@ -29,9 +29,9 @@ struct ChildRun {
   std::string output;
 };
 
-// Runs exit_child in `mode` (signalling it with `sig` once ready, if sig != 0) and collects its
-// output until it ends.
-ChildRun runChild(const std::string& mode, int sig = 0, const std::vector<std::string>& extra = {}) {
+// Runs exit_child in `mode` (signalling it with `sig` once ready, if sig != 0; `times` > 1: again
+// as soon as it says its shutdown began, times - 1 times) and collects its output until it ends.
+ChildRun runChild(const std::string& mode, int sig = 0, const std::vector<std::string>& extra = {}, int times = 1) {
   std::vector<std::string> argv{RP_EXIT_CHILD, mode, "-nogui"};
   argv.insert(argv.end(), extra.begin(), extra.end());
   test::ChildProcess child(argv);
@@ -42,6 +42,9 @@ ChildRun runChild(const std::string& mode, int sig = 0, const std::vector<std::s
     if (*line == "ready") {
       ready = true;
       if (sig != 0) child.signal(sig);
+    }
+    if (line->rfind("rp: system shutdown: ", 0) == 0 && ready) {
+      for (int k = 1; sig != 0 && k < times; ++k) child.signal(sig);
     }
   }
   EXPECT_TRUE(ready) << run.output;
@@ -82,6 +85,17 @@ TEST(ExitPath, SigintAndSigtermAlwaysCompleteTheShutdownAndExit128PlusTheSignal)
     EXPECT_EQ(r.status, 128 + sig) << r.output;
     EXPECT_TRUE(has(r, "rp: system shutdown complete")) << r.output;
     EXPECT_FALSE(has(r, "exit_child: done")) << r.output;
+  }
+}
+
+// A signal again while the shutdown runs (`timeout` sends its signal to the program and then to
+// its process group; an impatient Ctrl-C) does not cut the shutdown short: it used to end the
+// process at once (SIG_DFL), with no hold, no "complete" and the log left as FILE.part.
+TEST(ExitPath, ASecondSignalDuringTheShutdownDoesNotCutItShort) {
+  for (int sig : {SIGINT, SIGTERM}) {
+    const ChildRun r = runChild("signal", sig, {}, 3);
+    EXPECT_EQ(r.status, 128 + sig) << r.output;
+    EXPECT_TRUE(has(r, "rp: system shutdown complete")) << r.output;
   }
 }
 
@@ -131,9 +145,9 @@ class HardwareExitPath : public ::testing::Test {
 
   // Runs exit_child in `mode` against the server; `sig` is sent once it is ready. Checks that the
   // amplifiers were on while it ran, its exit status, and the outputs after it.
-  void run(const std::string& mode, int sig, int status) {
+  void run(const std::string& mode, int sig, int status, int times = 1) {
     const std::uint64_t tripsBefore = monitor_->watchdogTrips();
-    ChildRun r = runChild(mode, sig, {"-nosim", "-config", (dir_ / "rp.cfg").string()});
+    ChildRun r = runChild(mode, sig, {"-nosim", "-config", (dir_ / "rp.cfg").string()}, times);
     EXPECT_EQ(r.status, status) << mode << ":\n" << r.output;
     EXPECT_TRUE(waitUntilOff()) << mode << ": the amplifiers or a DAC are still on after the program ended";
     if (sig == SIGKILL) {
@@ -155,6 +169,7 @@ TEST_F(HardwareExitPath, ExceptionInCalculate) { run("throw", 0, RoboticPlatform
 TEST_F(HardwareExitPath, Sigint) { run("signal", SIGINT, 128 + SIGINT); }
 TEST_F(HardwareExitPath, Sigterm) { run("signal", SIGTERM, 128 + SIGTERM); }
 TEST_F(HardwareExitPath, Sigkill) { run("signal", SIGKILL, 128 + SIGKILL); }
+TEST_F(HardwareExitPath, SigintThreeTimes) { run("signal", SIGINT, 128 + SIGINT, 3); }
 TEST_F(HardwareExitPath, UncaughtException) { run("uncaught", 0, 1); }
 
 }  // namespace
