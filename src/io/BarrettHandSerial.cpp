@@ -178,14 +178,25 @@ IoStatus BarrettHandSerial::command(const std::string& cmd, std::string* reply, 
                       config_.port.c_str(), cmd.c_str(), printable(buffer).c_str());
   const std::string text = trim(buffer.substr(cmd.size(), buffer.size() - cmd.size() - 3));
   if (text.rfind("ERR", 0) == 0) {
-    int code = 0;
-    if (std::sscanf(text.c_str() + 3, "%d", &code) != 1)
+    // The code whole, as a number that fits (sscanf's %d is undefined on overflow: ERR
+    // 99999999999999999999 came out as -1, every error bit).
+    errno = 0;
+    char* end = nullptr;
+    const long parsed = std::strtol(text.c_str() + 3, &end, 10);
+    const bool whole = end != text.c_str() + 3 && trim(std::string(end)).empty();
+    if (!whole || errno == ERANGE || parsed < 0 || parsed > 65535)
       return error_.set(IoStatus::kProtocolError, "BarrettHand %s: '%s' failed: unreadable error reply '%s'",
                         config_.port.c_str(), cmd.c_str(), printable(text).c_str());
+    const int code = static_cast<int>(parsed);
     lastErrorCode_ = code;
     return error_.set(IoStatus::kDeviceError, "BarrettHand %s: '%s' failed: ERR %d (%s)", config_.port.c_str(),
                       cmd.c_str(), code, describeErrorCode(code).c_str());
   }
+  // A command whose reply the caller does not take (HI, GC, GO, T: motions and settings) answers
+  // with the prompt alone; text there is not this protocol (it was reported as success).
+  if (reply == nullptr && !text.empty())
+    return error_.set(IoStatus::kProtocolError, "BarrettHand %s: '%s' failed: unexpected reply '%s'",
+                      config_.port.c_str(), cmd.c_str(), printable(text).c_str());
   if (reply != nullptr) *reply = text;
   return IoStatus::kOk;
 }
@@ -195,10 +206,12 @@ IoStatus BarrettHandSerial::readPositions(std::array<int, 4>& counts) {
   if (IoStatus s = command("FGET P", &reply); s != IoStatus::kOk) return s;
   std::istringstream in(reply);
   std::array<int, 4> values{};
-  for (int& v : values)
-    if (!(in >> v))
-      return error_.set(IoStatus::kProtocolError, "BarrettHand %s: 'FGET P' failed: expected 4 positions, got '%s'",
-                        config_.port.c_str(), printable(reply).c_str());
+  bool ok = true;
+  for (int& v : values) ok = ok && static_cast<bool>(in >> v);
+  if (ok) in >> std::ws;
+  if (!ok || !in.eof())  // four numbers and nothing after them ("100 200 300 400abc" was taken)
+    return error_.set(IoStatus::kProtocolError, "BarrettHand %s: 'FGET P' failed: expected 4 positions, got '%s'",
+                      config_.port.c_str(), printable(reply).c_str());
   counts = values;
   return IoStatus::kOk;
 }

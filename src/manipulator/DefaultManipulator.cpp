@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <cstring>
 #include <mutex>
 #include <stdexcept>
 
@@ -797,8 +798,16 @@ void DefaultManipulator::writeOutputsOff() noexcept {
 
 void DefaultManipulator::ioFailure(const char* what, int line) {
   // Real-time safe: formats into a member buffer. The arm cannot be controlled: shut down.
-  std::snprintf(errorBuffer_, sizeof errorBuffer_, "%.60s: hardware failure %.40s (line %d): %.120s", nameBuffer_, what, line,
-                board_->lastError());
+  // The board's error gets all the room the rest leaves (cut at 120 characters, the cause of a
+  // Modbus failure, "Connection timed out", was lost).
+  const int n = std::snprintf(errorBuffer_, sizeof errorBuffer_, "%.60s: hardware failure %.40s (line %d): ", nameBuffer_,
+                              what, line);
+  if (n > 0 && static_cast<std::size_t>(n) < sizeof errorBuffer_ - 1) {
+    const char* cause = board_->lastError();
+    const std::size_t used = static_cast<std::size_t>(n), length = ::strnlen(cause, sizeof errorBuffer_ - 1 - used);
+    std::memcpy(errorBuffer_ + used, cause, length);
+    errorBuffer_[used + length] = '\0';
+  }
   setError(2, errorBuffer_);
   power_ = false;
   tau_.setZero();

@@ -111,6 +111,38 @@ TEST_F(BarrettHandSerialTest, GarbledReplyIsAProtocolError) {
   EXPECT_TRUE(contains(driver.lastError(), "'HI' failed: garbled reply")) << driver.lastError();
 }
 
+// Replies with the echo and the prompt right but the text between them not the protocol's: a
+// motion command answered with text was reported as done, FGET P with junk after its four
+// numbers was read, and an error code too large for an int came out as ERR -1 (every bit).
+TEST_F(BarrettHandSerialTest, RepliesThatAreNotTheProtocolAreProtocolErrors) {
+  BarrettHandSerial driver(config_);
+  ASSERT_EQ(driver.open(), IoStatus::kOk);
+  hand_.setFault(BarrettHandEmulator::Fault::kWrongText);
+  hand_.setWrongText("GARBAGE \x01\x02");
+  EXPECT_EQ(driver.closeGrasp(), IoStatus::kProtocolError);
+  EXPECT_TRUE(contains(driver.lastError(), "'GC' failed: unexpected reply 'GARBAGE ")) << driver.lastError();
+  for (const char* text : {"100 200 300 400 555", "100 200 300 400abc", "100 200 300", "0x10 20 30 40"}) {
+    hand_.setWrongText(text);
+    std::array<int, 4> p{};
+    EXPECT_EQ(driver.readPositions(p), IoStatus::kProtocolError) << text;
+    EXPECT_TRUE(contains(driver.lastError(), "'FGET P' failed: expected 4 positions, got '")) << driver.lastError();
+  }
+  hand_.setWrongText("  10 20 30 40  ");
+  std::array<int, 4> p{};
+  EXPECT_EQ(driver.readPositions(p), IoStatus::kOk) << driver.lastError();
+  EXPECT_EQ(p, (std::array<int, 4>{10, 20, 30, 40}));
+  for (const char* text : {"ERR 99999999999999999999", "ERR 4x", "ERR", "ERR -4"}) {
+    hand_.setWrongText(text);
+    EXPECT_EQ(driver.initialize(), IoStatus::kProtocolError) << text;
+    EXPECT_TRUE(contains(driver.lastError(), "'HI' failed: unreadable error reply")) << driver.lastError();
+  }
+  hand_.setWrongText("ERR 4");
+  EXPECT_EQ(driver.initialize(), IoStatus::kDeviceError);
+  EXPECT_EQ(driver.lastErrorCode(), 4);
+  hand_.setFault(BarrettHandEmulator::Fault::kNone);
+  EXPECT_EQ(driver.initialize(), IoStatus::kOk) << driver.lastError();
+}
+
 TEST_F(BarrettHandSerialTest, TruncatedReplyTimesOutAndSaysSo) {
   hand_.setFault(BarrettHandEmulator::Fault::kTruncated);
   BarrettHandSerial driver(config_);

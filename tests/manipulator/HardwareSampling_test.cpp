@@ -41,7 +41,11 @@ class RampBoard : public IoBoard {
   }
   IoStatus readAnalogInput(int, double&) noexcept override { return IoStatus::kInvalidLine; }
   IoStatus writeAnalogOutput(int, double) noexcept override { return IoStatus::kOk; }
+  std::atomic<bool> failing{false};
   IoStatus readEncoder(int encoder, std::int64_t& counts) noexcept override {
+    if (failing.load())  // as a Modbus board's read that timed out: the cause at the end
+      return error_.set(IoStatus::kTimeout,
+                        "RampBoard 127.0.0.1:40999: read encoder input registers %d failed: Connection timed out", encoder);
     while (stalled.load()) std::this_thread::sleep_for(std::chrono::microseconds(200));
     const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double home[6] = {-0.5 + speed_ * t, M_PI / 2, -M_PI / 2, 0, 0, 0};
@@ -96,6 +100,34 @@ TEST(HardwareSampling, AStalledServerIsNeitherAStandstillNorAVelocitySpike) {
     };
     EXPECT_EQ(outside(during), 0) << "while the server stalled the joint was read as standing still";
     EXPECT_EQ(outside(after), 0) << "after a stall the joint's velocity jumped";
+  }
+  server.stop();
+  ObjectManager::resetShutdown();
+  RoboticPlatform::setSimulationModeOn();
+}
+
+// A board failure shuts the arm down with the board's whole message: the arm's error was cut at
+// 120 characters of it, which lost the cause of a Modbus timeout ("... failed: Co").
+TEST(HardwareSampling, ABoardFailureIsReportedWithItsCause) {
+  const std::string name = "failing-" + std::to_string(::getpid());
+  RoboticPlatform::setConfiguration(Configuration::parse(
+      "[arm]\nclass Puma560\nsimulationMode off\nhwserver " + name + "\ncountsPerRadian 20000\n", "rp.cfg"));
+  RoboticPlatform::setSimulationModeOff();
+  RoboticPlatform::useRealClock();
+  ObjectManager::resetShutdown();
+  RampBoard board(0, 20000);
+  HwServer server(board, name, 1000.0, 5000.0);
+  server.start();
+  {
+    Puma560 arm("arm");
+    ASSERT_TRUE(arm.waitForCycles(100));
+    board.failing = true;
+    ASSERT_TRUE(ObjectManager::waitForShutdown(5));
+    const std::string message = arm.getErrorStatus().message;
+    EXPECT_EQ(message.rfind("arm: hardware failure ", 0), 0u) << message;  // (reading or writing: the next I/O)
+    EXPECT_NE(message.find("read encoder input registers 0 failed: Connection timed out"), std::string::npos) << message;
+    EXPECT_NE(ObjectManager::getShutdownReason().find("failed: Connection timed out"), std::string::npos)
+        << ObjectManager::getShutdownReason();
   }
   server.stop();
   ObjectManager::resetShutdown();

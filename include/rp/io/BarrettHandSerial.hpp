@@ -55,11 +55,11 @@ class BarrettHandSerial {
 
   /// Sends one command line (without the carriage return) and waits for the prompt.
   /// @param[in] command  e.g. `"GC"`, `"FGET P"`; printable ASCII, at most 120 characters
-  /// @param[out] reply  if not null, the reply text between the echo and the prompt, trimmed
+  /// @param[out] reply  if not null, the reply text between the echo and the prompt, trimmed (null: none allowed)
   /// @param[in] timeoutMs  how long to wait for the prompt [ms]; 0 = the configured timeout
   /// @return `kOk`; `kNotConnected` (port not open or closed by the device), `kTimeout` (no
-  ///         prompt: silent or truncated reply), `kProtocolError` (the echo does not match: garbled
-  ///         reply), `kDeviceError` (the hand answered `ERR <n>`, see `lastErrorCode()`)
+  ///         prompt: silent or truncated reply), `kProtocolError` (a garbled echo, text where none
+  ///         was asked for, an unreadable `ERR`), `kDeviceError` (`ERR <n>`, see `lastErrorCode()`)
   /// Real-time safe: no.
   IoStatus command(const std::string& command, std::string* reply = nullptr, int timeoutMs = 0);
 

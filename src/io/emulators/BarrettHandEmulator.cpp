@@ -97,6 +97,16 @@ void BarrettHandEmulator::serve() {
         case Fault::kTruncated:
           send("\n\r");
           break;
+        case Fault::kWrongText: {
+          std::string reply = "\n\r";
+          {
+            std::lock_guard lock(mutex_);
+            reply.append(wrongText_);
+          }
+          reply.append("\n\r=> ");
+          send(reply);
+          break;
+        }
         case Fault::kError: {
           std::string reply = "\n\rERR ";
           reply.append(std::to_string(errorCode_.load()));

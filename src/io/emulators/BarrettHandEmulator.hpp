@@ -21,7 +21,9 @@ class BarrettHandEmulator {
   };
   // Silent: read commands, answer nothing. Garbled: answer bytes that are not the echo.
   // Truncated: echo and part of the reply, no prompt. Error: answer every command with ERR errorCode.
-  enum class Fault { kNone, kSilent, kGarbled, kTruncated, kError };
+  // WrongText: echo and prompt as the hand's, with setWrongText()'s text between them whatever
+  // the command (a reply that is not the protocol's).
+  enum class Fault { kNone, kSilent, kGarbled, kTruncated, kError, kWrongText };
 
   explicit BarrettHandEmulator(const Config& config);
   BarrettHandEmulator();
@@ -39,6 +41,10 @@ class BarrettHandEmulator {
   void setFault(Fault fault, int errorCode = 32) {
     errorCode_.store(errorCode);
     fault_.store(fault);
+  }
+  void setWrongText(const std::string& text) {
+    std::lock_guard lock(mutex_);
+    wrongText_ = text;
   }
   bool initialized() const { return initialized_.load(); }
   std::array<int, 4> positions() const;
@@ -60,6 +66,7 @@ class BarrettHandEmulator {
   mutable std::mutex mutex_;
   std::array<int, 4> positions_{};
   std::vector<std::string> commands_;
+  std::string wrongText_;  // under mutex_
   std::thread thread_;
 };
 
