@@ -153,7 +153,11 @@ bool ForceTorqueSensor::update() noexcept {
   std::snprintf(message, sizeof message, "%s (after %d cycles without a reading)", hardwareError(), missedCycles_);
   setError(1, message);
   shutdownRequested_.store(true);
-  requestSystemShutdown("force/torque sensor failed");
+  // The shutdown's reason (stderr, the pages, the exit line) gives the cause, which names the
+  // sensor's device; it said only "force/torque sensor failed". (No allocation: no getName().)
+  char reason[256];
+  std::snprintf(reason, sizeof reason, "force/torque sensor failed: %.200s", message);
+  requestSystemShutdown(reason);
   return false;
 }
 
