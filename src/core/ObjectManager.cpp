@@ -60,8 +60,8 @@ void watcher() {
     {
       std::lock_guard<std::mutex> lock(reg.doneMutex);
       reg.done = true;
+      reg.shutdownComplete.store(true);  // (with `done`: a resetShutdown() cannot come between)
     }
-    reg.shutdownComplete.store(true);
     reg.doneCv.notify_all();
     if (int sig = reg.signalNumber.load()) {
       std::fflush(stderr);  // not stdout: a main thread blocked writing to a full pipe may hold its lock

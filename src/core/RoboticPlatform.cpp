@@ -142,14 +142,11 @@ std::vector<std::string> RoboticPlatform::parseCommandLine(const std::vector<std
     else if (a == "-log") setLogFileName(value("a CSV file name"));
     else if (a == "-gui-address") setGuiAddress(value("an IP address"));
     else if (a == "-gui-token") {
-      // Pages present the token in the URL as it is (the Scene Viewer does not percent-decode):
-      // any other character would make a token no page can present.
-      const std::string v = value("a token");
-      if (v.size() > 256 || v.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-._~") !=
-                                std::string::npos)
-        throw std::invalid_argument("switch '-gui-token' needs 1 to 256 letters, digits and - . _ ~ (it goes into the "
-                                    "URL as it is), not '" + v + "'");
-      setGuiToken(v);
+      try {
+        setGuiToken(value("a token"));
+      } catch (const std::invalid_argument& e) {  // (the token itself, a secret, is not repeated)
+        throw std::invalid_argument(std::string("switch '-gui-token' needs ") + e.what());
+      }
     }
     else if (a == "-gui-port") {
       const std::string v = value("a port number 0..65535");
@@ -295,6 +292,11 @@ int RoboticPlatform::getGuiPort() {
 }
 
 void RoboticPlatform::setGuiToken(const std::string& token) {
+  // Pages present the token in the URL as it is (the Scene Viewer does not percent-decode): any
+  // other character would make a token no page can present ('a&b c' locked every page out).
+  if (token.size() > 256 ||
+      token.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-._~") != std::string::npos)
+    throw std::invalid_argument("at most 256 letters, digits and - . _ ~ (a token goes into the URL as it is)");
   std::lock_guard<std::mutex> lock(state().mutex);
   state().guiToken = token;
 }

@@ -87,8 +87,12 @@ std::unique_ptr<ManipulatorModel> loadFor(const ConfigSection* section, const st
     // A file rp.cfg names: that line first, then the loader's own error (naming the URDF file and
     // the joint or link), so a user of rp.cfg sees where the file came from.
     const ConfigSetting* setting = section != nullptr ? section->find("urdf") : nullptr;
+    // An unknown tip that rp.cfg named: that line instead.
+    if (const ConfigSetting* t = section != nullptr ? section->find("tip") : nullptr;
+        t != nullptr && !t->values.empty() && std::string(e.what()).find("'" + t->values[0] + "'") != std::string::npos)
+      setting = t;
     if (setting == nullptr) throw;
-    throw UrdfError(section->fileName() + ":" + std::to_string(setting->line) + ": urdf: " + e.what());
+    throw UrdfError(section->fileName() + ":" + std::to_string(setting->line) + ": " + setting->name + ": " + e.what());
   }
   for (const std::string& note : notes) std::cerr << "rp: UrdfManipulator '" << name << "': " << note << std::endl;
   // Place the arm where the object stands: the object's pose times the URDF's own base frame.

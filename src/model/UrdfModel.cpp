@@ -276,8 +276,11 @@ void checkInertials(const TiXmlElement* robot, const std::string& fileName) {
     }
     Eigen::Matrix3d I;
     I << v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5];
-    const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I, Eigen::EigenvaluesOnly).eigenvalues()(0);
-    if (smallest < -1e-9 * (1 + I.cwiseAbs().maxCoeff()))
+    // Relative to the largest principal moment: files written with 5 significant digits put a
+    // thin rod's smallest moment at -1e-5 of it (an absolute bound refused them).
+    const Eigen::Vector3d moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I, Eigen::EigenvaluesOnly).eigenvalues();
+    const double smallest = moments(0);
+    if (smallest < -1e-4 * moments.cwiseAbs().maxCoeff() - 1e-12)
       throw UrdfError(where + "inertia is not positive semi-definite (smallest eigenvalue " + shortNumber(smallest) +
                       " kg m^2)");
   }
@@ -868,6 +871,12 @@ std::unique_ptr<ManipulatorModel> loadUrdfString(const std::string& text, const 
         std::snprintf(range, sizeof range, "lower %g is above upper %g", l.positionMin, l.positionMax);
         throw UrdfError(joint + ": <limit> " + range);
       }
+      // A limit a robot cannot have: some tools write +-1.8e308 for "none", which broke the
+      // load's own check ("internal error: ... differs") and every range computed from it.
+      for (const auto& [what, value] : {std::pair<const char*, double>{"lower", l.positionMin}, {"upper", l.positionMax}})
+        if (std::abs(value) > 1e6)
+          throw UrdfError(joint + ": <limit> " + what + " " + shortNumber(value) +
+                          " is beyond 1e6 in magnitude (a joint without limits is type=\"continuous\")");
     }
     if (j->limits && j->limits->effort > 0) l.torqueLimit = j->limits->effort;
     if (j->limits && j->limits->velocity > 0) l.velocityLimit = j->limits->velocity * options.velocityLimitScale;

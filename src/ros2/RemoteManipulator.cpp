@@ -177,28 +177,20 @@ bool RemoteManipulator::Impl::takeJointStates() {
         column[static_cast<std::size_t>(i)] = c;
       }
     }
-    // A value that is not a number is no state of an arm: the sample is refused (not stored) and
-    // named once; the reader thread makes it a fault, connect() an error.
+    // A position that is not a number is no state of an arm: the sample is refused (not stored)
+    // and named once; the reader thread makes it a fault, connect() an error. (A velocity or
+    // effort that is not a number is one the publisher does not have, as ros2_control's
+    // joint_state_broadcaster writes it: taken as absent, 0, like a missing array.)
     for (int i = 0; i < n && ours; ++i) {
-      const auto c = static_cast<uint32_t>(column[static_cast<std::size_t>(i)]);
-      const struct {
-        const char* field;
-        bool given;
-        double value;
-      } values[] = {{"position", true, js.position._buffer[c]},
-                    {"velocity", js.velocity._length == js.name._length, js.velocity._length == js.name._length ? js.velocity._buffer[c] : 0.0},
-                    {"effort", js.effort._length == js.name._length, js.effort._length == js.name._length ? js.effort._buffer[c] : 0.0}};
-      for (const auto& v : values) {
-        if (!v.given || std::isfinite(v.value)) continue;
-        if (badSample.empty()) {
-          char text[320];
-          std::snprintf(text, sizeof text, "the remote arm %.120s sent joint_states with %.40s of joint '%.60s' %g: not a finite number",
-                        label.c_str(), v.field, jointNames[static_cast<std::size_t>(i)].c_str(), v.value);
-          badSample = text;
-        }
-        ours = false;
-        break;
+      const double q = js.position._buffer[static_cast<uint32_t>(column[static_cast<std::size_t>(i)])];
+      if (std::isfinite(q)) continue;
+      if (badSample.empty()) {
+        char text[320];
+        std::snprintf(text, sizeof text, "the remote arm %.120s sent joint_states with position of joint '%.60s' %g: not a finite number",
+                      label.c_str(), jointNames[static_cast<std::size_t>(i)].c_str(), q);
+        badSample = text;
       }
+      ours = false;
     }
     if (ours) {
       const double receipt = 1e-9 * static_cast<double>(ros2detail::wallNanoseconds());
@@ -208,8 +200,8 @@ bool RemoteManipulator::Impl::takeJointStates() {
         for (int i = 0; i < n; ++i) {
           const auto c = static_cast<uint32_t>(column[static_cast<std::size_t>(i)]);
           q(i) = js.position._buffer[c];
-          qd(i) = js.velocity._length == js.name._length ? js.velocity._buffer[c] : 0.0;
-          tau(i) = js.effort._length == js.name._length ? js.effort._buffer[c] : 0.0;
+          qd(i) = js.velocity._length == js.name._length && std::isfinite(js.velocity._buffer[c]) ? js.velocity._buffer[c] : 0.0;
+          tau(i) = js.effort._length == js.name._length && std::isfinite(js.effort._buffer[c]) ? js.effort._buffer[c] : 0.0;
         }
       }
       Joints j{};

@@ -48,6 +48,8 @@ void ensureShutdownWatcher();
 
 namespace {
 
+constexpr double kMinRate = 1;  // Hz: the lowest rate setRate() accepts
+
 // A number in a message, as short as its value allows ("11", "1e+300"; std::to_string printed
 // 1e300 with 300 digits and 0.1 as 0.100000).
 std::string shortNumber(double v) {
@@ -932,8 +934,10 @@ const std::string& ControlProgram::getProgramName() const { return impl_->name; 
 
 void ControlProgram::setRate(double hz) {
   impl_->checkNotRunning("setRate");
-  if (!(hz > 0) || !(hz <= kMaxRate))
-    throw std::invalid_argument("ControlProgram::setRate: the rate must be in (0, 20000] Hz, got " + std::to_string(hz));
+  // At least 1 Hz: a period over a second is no control loop, and 1e-11 Hz overflowed the period
+  // in nanoseconds (qmotorConfig's 'rate' has the same range).
+  if (!(hz >= internal::kMinRate) || !(hz <= kMaxRate))
+    throw std::invalid_argument("ControlProgram::setRate: the rate must be in [1, 20000] Hz, got " + internal::shortNumber(hz));
   impl_->rate = hz;
 }
 double ControlProgram::getRate() const { return impl_->rate; }
@@ -1472,7 +1476,7 @@ bool parseNumber(const std::string& token, double& value);  // Configuration.cpp
 namespace {
 
 // Ranges of the control-program settings a qmotorConfig file may give (docs/core.md).
-constexpr double kMinQMotorRate = 1;  // Hz: a period of at most 1 s (rate 1e-11 overflowed the period)
+constexpr double kMinQMotorRate = internal::kMinRate;  // Hz: a period of at most 1 s (1e-11 overflowed it)
 constexpr double kMaxQMotorRate = ControlProgram::kMaxRate;  // Hz
 constexpr long long kMaxQMotorLogEvery = ControlProgram::kMaxLogEvery;  // cycles
 constexpr auto kMaxQMotorLogBuffer = static_cast<long long>(ControlProgram::kMaxLogBufferSize);  // samples

@@ -27,7 +27,7 @@ std::string errorText(int e) { return std::strerror(e); }
 // rp.cfg, a URDF, a log of another tool - is someone's data.
 bool replaceableByALog(const std::string& name) {
   const int fd = ::open(name.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
-  if (fd < 0) return true;  // unreadable: opening it for writing will say why
+  if (fd < 0) return errno == ENOENT;  // gone since: nothing to lose; unreadable: not known to be a log
   char head[2] = {0, 0};
   ssize_t got = 0;
   do {
@@ -44,8 +44,8 @@ LogFile::LogFile(const std::string& fileName) : fileName_(fileName) {
   if (fileName.empty()) refuse("no file name");
   auto refuseUnlessALog = [&](const std::string& what) {
     if (!replaceableByALog(fileName))
-      refuse(what + "a file that is not a log (its first line is no header 't,...'): a log never replaces it (name "
-             "another file, or remove this one)");
+      refuse(what + "a file that is not a log (its first line is no header 't,...', or it cannot be read): a log never "
+             "replaces it (name another file, or remove this one)");
   };
   struct stat st {};
   if (::lstat(fileName.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {

@@ -19,11 +19,11 @@ LogRecovery writeCompleteLog(const std::string& partFile, int fd, const std::str
 class LogFile {
  public:
   // Claims the log FILE (throws std::runtime_error naming the file and the reason):
-  // - FILE absent or a regular file: writes to FILE.part, created exclusively (a second run with
-  //   the same FILE, or the leftover of a killed one, is refused); finish() renames it to FILE.
+  // - FILE absent, empty or a log (first line 't,...'): writes to FILE.part, created exclusively (a
+  //   second run with the same FILE, or the leftover of a killed one, is refused); finish() renames it.
   // - FILE a FIFO, a character device (/dev/null, a terminal) or a symbolic link to one of these
-  //   or to a regular file: writes to FILE itself (locked while written), never replacing it.
-  // - a directory, a block device, a socket or a dangling link: refused.
+  //   or to an empty file or a log: writes to FILE itself (locked while written), never replacing it.
+  // - a directory, a block device, a socket, a dangling link, a file that is not a log: refused.
   explicit LogFile(const std::string& fileName);
   ~LogFile();
   LogFile(const LogFile&) = delete;

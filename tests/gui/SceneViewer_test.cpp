@@ -606,8 +606,10 @@ TEST(SceneViewer, PlatformSwitches) {
       FAIL() << bad;
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find("-gui-token"), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).find(bad), std::string::npos) << "the refused token (a secret) is repeated";
     }
   }
+  EXPECT_THROW(rp::RoboticPlatform::setGuiToken("a b"), std::invalid_argument);
   EXPECT_EQ(rp::RoboticPlatform::getGuiToken(), "abc") << "a refused token replaced the last";
   EXPECT_THROW(rp::RoboticPlatform::setGuiPort(70000), std::invalid_argument);
   rp::RoboticPlatform::setGuiAddress("127.0.0.1");

@@ -881,7 +881,7 @@ TEST_F(ManipulatorTest, AnyArmFromAUrdfFileIsSimulatedAndHeld) {
     om.createDerivedObject<Manipulator>("arm");
     ADD_FAILURE() << "an unknown tip was accepted";
   } catch (const UrdfError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("rp.cfg:3: urdf: ", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("rp.cfg:4: tip: ", 0), 0u) << e.what();  // the tip's line
     EXPECT_NE(std::string(e.what()).find("nolink"), std::string::npos) << e.what();
   }
   RoboticPlatform::setConfiguration(Configuration::parse("\n[arm]\nclass UrdfManipulator\n", "rp.cfg"));

@@ -769,7 +769,9 @@ TEST_F(UrdfInputTest, InertiasThatAreNotPositiveSemiDefiniteAreRefusedWithTheLin
                             "-4.9 kg m^2)");
   for (const char* inertia : {"ixx=\"0.066\" ixy=\"0\" ixz=\"0\" iyy=\"0.086\" iyz=\"0\" izz=\"0.0125\"",  // Puma link 3
                               "ixx=\"0\" ixy=\"0\" ixz=\"0\" iyy=\"0\" iyz=\"0\" izz=\"0\"",
-                              "ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"-1e-12\" iyz=\"0\" izz=\"0.01\""}) {  // rounding
+                              "ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"-1e-12\" iyz=\"0\" izz=\"0.01\"",  // rounding
+                              // a thin rod written with 5 significant digits: smallest moment -1e-7
+                              "ixx=\"0.00375\" ixy=\"-0.0037501\" ixz=\"0\" iyy=\"0.00375\" iyz=\"0\" izz=\"0.0075\""}) {
     f = arm("2", inertia);
     EXPECT_EQ(message(f), "no error") << inertia;
   }
@@ -810,6 +812,22 @@ TEST_F(UrdfInputTest, HugeLengthsMassesAndInertiasAreRefusedWithTheElement) {
   qd(0) = 1;
   EXPECT_TRUE(massMatrix(*model, data, q).allFinite());
   EXPECT_TRUE(inverseDynamics(*model, data, q, qd, qd).allFinite());
+  // Joint limits of +-1.7e308 ("none", as some exporters write it) failed the load's own check
+  // as an "internal error"; they are refused naming the joint (and +-1e6 loads).
+  const std::string limited = "<robot name=\"arm\"><link name=\"base\"/><link name=\"upper\">" + inertial("1") +
+                              "</link><joint name=\"shoulder\" type=\"revolute\"><parent link=\"base\"/><child "
+                              "link=\"upper\"/><axis xyz=\"0 0 1\"/><limit lower=\"LO\" upper=\"1.7e308\" "
+                              "effort=\"1\" velocity=\"1\"/></joint></robot>";
+  std::string text = limited;
+  text.replace(text.find("LO"), 2, "-1.7e308");
+  f = write("limits.urdf", text);
+  EXPECT_EQ(message(f), f + ": joint 'shoulder': <limit> lower -1.7e+308 is beyond 1e6 in magnitude (a joint without "
+                            "limits is type=\"continuous\")");
+  text = limited;
+  text.replace(text.find("LO"), 2, "-1e6");
+  text.replace(text.find("1.7e308"), 7, "1e6");
+  f = write("limits.urdf", text);
+  EXPECT_EQ(message(f), "no error");
 }
 
 TEST_F(UrdfInputTest, SpecialDeepAndHugeFilesAreRefused) {

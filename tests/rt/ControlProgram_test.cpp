@@ -73,6 +73,9 @@ TEST(ControlProgram, Defaults) {
   EXPECT_EQ(r.getLogEvery(), 1u);
   EXPECT_FALSE(r.isRunning());
   EXPECT_THROW(r.setRate(0), std::invalid_argument);
+  EXPECT_THROW(r.setRate(0.5), std::invalid_argument);    // a period over a second
+  EXPECT_THROW(r.setRate(1e-11), std::invalid_argument);  // (its period overflowed in nanoseconds)
+  r.setRate(1);
   EXPECT_THROW(r.setRate(20001), std::invalid_argument);  // every cycle would overrun
   EXPECT_THROW(r.setRate(std::nan("")), std::invalid_argument);
   EXPECT_THROW(r.setLogBufferSize(1), std::invalid_argument);

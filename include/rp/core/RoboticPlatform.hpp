@@ -79,7 +79,7 @@ class RoboticPlatform {
   /// The Scene Viewer's TCP port as set (-1: the default).
   static int getGuiPort();
   /// Sets the token pages must present (`-gui-token`); empty: none on loopback, generated otherwise.
-  /// @param[in] token  the token
+  /// @param[in] token  the token: at most 256 of `A-Z a-z 0-9 - . _ ~` (else std::invalid_argument)
   static void setGuiToken(const std::string& token);
   /// The token set with setGuiToken() (empty if none was given).
   static std::string getGuiToken();

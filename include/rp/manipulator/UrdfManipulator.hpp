@@ -29,7 +29,7 @@ class UrdfManipulator : public DefaultManipulator {
   /// @param[in] name      object name (its rp.cfg section, if any); empty for an automatic name
   /// @param[in] urdfFile  URDF path; rp.cfg's `urdf` setting overrides it
   /// @param[in] tip       tip link; rp.cfg's `tip` setting overrides it
-  /// @throws UrdfError for a bad file; std::invalid_argument if no URDF file is given
+  /// @throws UrdfError for a bad file (from rp.cfg: its `urdf` or `tip` line first); no file: ConfigError (an rp.cfg section), else std::invalid_argument
   explicit UrdfManipulator(const std::string& name = "", const std::string& urdfFile = "", const std::string& tip = "");
   ~UrdfManipulator() override;
   /// Declares `urdf`, `tip`, `packagePath` and `offChainPositions`.

@@ -158,7 +158,7 @@ class ControlProgram {
   static constexpr std::size_t kMaxLogBufferSize = 1000000;
 
   /// Sets the loop rate (default 1000 Hz).
-  /// @param[in] hz  rate [Hz], in (0, kMaxRate]
+  /// @param[in] hz  rate [Hz], in [1, kMaxRate] (a period of at most 1 s)
   /// @throws std::invalid_argument if out of range or not finite
   /// @throws std::logic_error if running
   void setRate(double hz);

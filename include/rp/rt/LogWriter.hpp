@@ -29,8 +29,8 @@ struct LogSeries {
 /// While running, rows go to `FILE.part` (created exclusively: a second run with the same FILE is
 /// refused); close() (called by stop, system shutdown, SIGINT, SIGTERM and normal exit) drains
 /// every ring buffer and renames it to `FILE`. A FILE that is not a regular file (a FIFO,
-/// `/dev/null`, a terminal, a symbolic link) is written in place and never replaced; a directory
-/// is refused. Every write is checked: on the first failure (a full disk, a file size limit, a
+/// `/dev/null`, a terminal, a symbolic link) is written in place and never replaced; a directory, and a file
+/// not empty and not a log (`-log rp.cfg`), are refused. Every write is checked: on a failure (a full disk, a
 /// reader gone) the writer says so on stderr at once, cuts the file back to its last complete row,
 /// writes nothing more and hasFailed() turns true; close() still completes FILE with the rows
 /// kept. After a kill, recoverLog() (`rp-log recover FILE.part`) makes a log of `FILE.part`.
