@@ -291,11 +291,18 @@ int RoboticPlatform::getGuiPort() {
   return state().guiPort;
 }
 
+namespace internal {
+// Whether `token` can be a Scene Viewer token: pages present it in the URL as it is (the viewer
+// does not percent-decode), so at most 256 of the URL's unreserved characters ('a&b c' locked
+// every page out). SceneViewer::start() checks its options with it too.
+bool isUrlToken(const std::string& token) {
+  return token.size() <= 256 &&
+         token.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-._~") == std::string::npos;
+}
+}  // namespace internal
+
 void RoboticPlatform::setGuiToken(const std::string& token) {
-  // Pages present the token in the URL as it is (the Scene Viewer does not percent-decode): any
-  // other character would make a token no page can present ('a&b c' locked every page out).
-  if (token.size() > 256 ||
-      token.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-._~") != std::string::npos)
+  if (!internal::isUrlToken(token))
     throw std::invalid_argument("at most 256 letters, digits and - . _ ~ (a token goes into the URL as it is)");
   std::lock_guard<std::mutex> lock(state().mutex);
   state().guiToken = token;

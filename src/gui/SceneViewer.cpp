@@ -50,6 +50,10 @@
 
 namespace rp {
 
+namespace internal {
+bool isUrlToken(const std::string& token);  // RoboticPlatform.cpp: the characters a token may have
+}  // namespace internal
+
 namespace {
 
 namespace asio = boost::asio;
@@ -839,8 +843,7 @@ void SceneViewer::Impl::onMessage(const std::shared_ptr<WsSession>& session, std
       values.push_back(v.get<double>());
       if (hasIndex) {
         const json& i = msg["index"];
-        if (!i.is_number_integer() || (i.is_number_unsigned() ? i.get<unsigned long long>() > 1000000
-                                                              : i.get<long long>() < 0 || i.get<long long>() > 1000000))
+        if (!i.is_number_integer() || i.get<long long>() < 0 || i.get<long long>() > 1000000)
           return refuse("'index' must be a non-negative integer");
         index = i.get<long long>();
       }
@@ -1070,9 +1073,7 @@ void SceneViewer::start(const SceneViewerOptions& options) {
   auto address = asio::ip::make_address(options.address, ec);
   if (ec) throw std::invalid_argument("SceneViewer: '" + options.address + "' is not an IP address");
 
-  if (options.token.size() > 256 ||
-      options.token.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-._~") !=
-          std::string::npos)
+  if (!internal::isUrlToken(options.token))
     throw std::invalid_argument("SceneViewer: the token must be at most 256 letters, digits and - . _ ~ (pages present "
                                 "it in the URL as it is)");
 

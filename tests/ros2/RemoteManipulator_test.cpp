@@ -222,25 +222,10 @@ TEST_F(RemoteManipulatorTest, ReportsLatencyLossAndTheRemoteRefusal) {
 // both name the joint. A velocity or effort that is not a number is one the publisher does not
 // have (ros2_control's joint_state_broadcaster writes NaN for those): taken as absent, 0.
 TEST_F(RemoteManipulatorTest, AJointStateThatIsNotANumberIsRefusedNamingTheJoint) {
-  participant_ = dds_create_participant(static_cast<dds_domainid_t>(options_.domain), nullptr, nullptr);
-  ASSERT_GT(participant_, 0);
-  auto topicWriter = [&](const dds_topic_descriptor_t& desc, const std::string& topic, bool latched) {
-    const std::string name = "rt/" + ns_ + "/" + topic;
-    const dds_entity_t t = dds_create_topic(participant_, &desc, name.c_str(), nullptr, nullptr);
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-    dds_qset_durability(qos, latched ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
-    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, latched ? 1 : 10);
-    dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
-    dds_qset_data_representation(qos, 1, &xcdr1);
-    const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
-    dds_delete_qos(qos);
-    EXPECT_GT(w, 0) << name;
-    return w;
-  };
-  const dds_entity_t description = topicWriter(std_msgs_msg_dds__String__desc, "arm/robot_description", true);
-  const dds_entity_t state = topicWriter(std_msgs_msg_dds__String__desc, "arm/state", false);
-  const dds_entity_t joints = topicWriter(sensor_msgs_msg_dds__JointState__desc, "joint_states", false);
+  const std::string wire = "rt/" + ns_ + "/";
+  const dds_entity_t description = topicWriter(std_msgs_msg_dds__String__desc, wire + "arm/robot_description", true);
+  const dds_entity_t state = topicWriter(std_msgs_msg_dds__String__desc, wire + "arm/state");
+  const dds_entity_t joints = topicWriter(sensor_msgs_msg_dds__JointState__desc, wire + "joint_states");
   const std::string urdf = toUrdf(Puma560Model());
   std_msgs_msg_dds__String_ d{};
   d.data = const_cast<char*>(urdf.c_str());
@@ -278,14 +263,7 @@ TEST_F(RemoteManipulatorTest, AJointStateThatIsNotANumberIsRefusedNamingTheJoint
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
   });
-  struct Join {
-    std::atomic<bool>& stop;
-    std::thread& t;
-    ~Join() {
-      stop = true;
-      t.join();
-    }
-  } join{stop, remote};
+  StopAndJoin join{stop, remote};
   configure("[leader]\nclass RemoteManipulator\nremote " + ns_ + "/arm\ndomain " + std::to_string(options_.domain) +
             "\nconnectTimeout 30\n");
 

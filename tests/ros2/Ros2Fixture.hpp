@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <string>
@@ -16,6 +17,16 @@
 namespace rp::test {
 
 inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Sets `stop` and joins `thread` when the scope ends, however it ends (a test's fake remote arm).
+struct StopAndJoin {
+  std::atomic<bool>& stop;
+  std::thread& thread;
+  ~StopAndJoin() {
+    stop = true;
+    thread.join();
+  }
+};
 
 // A domain and a namespace of this process's own, so that parallel test processes never meet.
 inline Ros2BridgeOptions uniqueOptions() {
@@ -77,20 +88,29 @@ class Ros2Fixture : public ::testing::Test {
     return false;
   }
 
-  // A writer of ROS topic `topic` in the bridge's namespace with ROS 2's QoS (reliable, keep-last
-  // 10, XCDR1), once the bridge's reader is matched.
-  dds_entity_t writer(const dds_topic_descriptor_t& desc, const std::string& topic) {
+  // A writer of the DDS topic `name` (on the wire, "rt/NS/TOPIC") with ROS 2's QoS (reliable,
+  // keep-last 10, XCDR1), or transient-local keep-last 1 as robot_description is offered; it does
+  // not wait for a reader (a test's fake remote arm writes before the program under test exists).
+  dds_entity_t topicWriter(const dds_topic_descriptor_t& desc, const std::string& name, bool transientLocal = false) {
     if (participant_ <= 0) participant_ = dds_create_participant(static_cast<dds_domainid_t>(options_.domain), nullptr, nullptr);
-    const std::string name = "rt/" + options_.nameSpace + "/" + topic;
     const dds_entity_t t = dds_create_topic(participant_, &desc, name.c_str(), nullptr, nullptr);
     dds_qos_t* qos = dds_create_qos();
     dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+    dds_qset_durability(qos, transientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, transientLocal ? 1 : 10);
     dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
     dds_qset_data_representation(qos, 1, &xcdr1);
     const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
     dds_delete_qos(qos);
     EXPECT_GT(w, 0) << name;
+    return w;
+  }
+
+  // A writer of ROS topic `topic` in the bridge's namespace with ROS 2's QoS (reliable, keep-last
+  // 10, XCDR1), once the bridge's reader is matched.
+  dds_entity_t writer(const dds_topic_descriptor_t& desc, const std::string& topic) {
+    const std::string name = "rt/" + options_.nameSpace + "/" + topic;
+    const dds_entity_t w = topicWriter(desc, name);
     dds_publication_matched_status_t matched{};
     const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
     while (dds_get_publication_matched_status(w, &matched) >= 0 && matched.current_count == 0 &&

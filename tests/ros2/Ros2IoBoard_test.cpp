@@ -28,16 +28,6 @@
 namespace rp::test {
 namespace {
 
-// Sets `stop` and joins `thread` when the scope ends, however it ends.
-struct StopAndJoin {
-  std::atomic<bool>& stop;
-  std::thread& thread;
-  ~StopAndJoin() {
-    stop = true;
-    thread.join();
-  }
-};
-
 class Ros2IoBoardTest : public Ros2Fixture {
  protected:
   void SetUp() override {
