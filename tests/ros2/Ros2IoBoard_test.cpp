@@ -181,6 +181,13 @@ TEST_F(Ros2IoBoardTest, PickAndPlaceRunsUnchangedAgainstAnArmInAnotherProcess) {
 // ran, they made the program read joint 2 at 2.0-2.3 rad/s while it moved at 1.6, and stop at the
 // 2 rad/s limit, in 6 of 7 runs.)
 TEST_F(Ros2IoBoardTest, PickAndPlaceRunsUnchangedWhileTheArmsProcessStalls) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  // Not in a sanitizer build: there both processes' servo loops already miss about one cycle in
+  // ten without the stalls (the project's CI saw 335 missed cycles of the arm's 2,622 and 195 of
+  // the program's 1,690, and the arm stopping at joint 2's velocity limit: an overloaded torque
+  // loop's safe stop, not a stamping error). The release build runs this test in CI.
+  GTEST_SKIP() << "a sanitizer build is itself a larger stall than this test's; the release build runs it";
+#endif
   const Outcome local = run(writeConfig("local.cfg", "[Puma560]\nclass Puma560\n"));
   ASSERT_EQ(local.status, 0) << local.err;
   auto arm = startArm();
