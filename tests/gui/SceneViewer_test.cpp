@@ -383,12 +383,13 @@ class FdLimitServer {
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_adddup2(&actions, in[0], 0);
     posix_spawn_file_actions_adddup2(&actions, out[1], 1);
-    const char* argv[] = {RP_FD_LIMIT_SERVER, "128", nullptr};
-    const int rc = posix_spawn(&pid_, RP_FD_LIMIT_SERVER, &actions, nullptr, const_cast<char**>(argv), environ);
+    const std::string server = RP_FD_LIMIT_SERVER;
+    const char* argv[] = {server.c_str(), "128", nullptr};
+    const int rc = posix_spawn(&pid_, server.c_str(), &actions, nullptr, const_cast<char**>(argv), environ);
     posix_spawn_file_actions_destroy(&actions);
     ::close(in[0]);
     ::close(out[1]);
-    if (rc != 0) throw std::runtime_error("cannot start " RP_FD_LIMIT_SERVER);
+    if (rc != 0) throw std::runtime_error("cannot start " + server);
     to_ = ::fdopen(in[1], "w");
     from_ = ::fdopen(out[0], "r");
   }

@@ -855,7 +855,7 @@ TEST_F(ManipulatorTest, CreatedByNameFromTheConfiguration) {
 
 TEST_F(ManipulatorTest, AnyArmFromAUrdfFileIsSimulatedAndHeld) {
   RoboticPlatform::setConfiguration(Configuration::parse(
-      "[arm]\nclass UrdfManipulator\nurdf " RP_TEST_MODEL_DATA "/test_arm.urdf\ntip tool\nposition 0 0 100\n", "rp.cfg"));
+      "[arm]\nclass UrdfManipulator\nurdf " + RP_TEST_MODEL_DATA + "/test_arm.urdf\ntip tool\nposition 0 0 100\n", "rp.cfg"));
   ObjectManager om;
   Manipulator* arm = om.createDerivedObject<Manipulator>("arm");
   ASSERT_EQ(arm->getNumberOfJoints(), 6);
@@ -876,7 +876,7 @@ TEST_F(ManipulatorTest, AnyArmFromAUrdfFileIsSimulatedAndHeld) {
     EXPECT_EQ(std::string(e.what()).rfind("rp.cfg:3: urdf: nosuchfile.urdf: ", 0), 0u) << e.what();
   }
   RoboticPlatform::setConfiguration(Configuration::parse(
-      "[arm]\nclass UrdfManipulator\nurdf " RP_TEST_MODEL_DATA "/test_arm.urdf\ntip nolink\n", "rp.cfg"));
+      "[arm]\nclass UrdfManipulator\nurdf " + RP_TEST_MODEL_DATA + "/test_arm.urdf\ntip nolink\n", "rp.cfg"));
   try {
     om.createDerivedObject<Manipulator>("arm");
     ADD_FAILURE() << "an unknown tip was accepted";
@@ -898,14 +898,14 @@ TEST_F(ManipulatorTest, AnyArmFromAUrdfFileIsSimulatedAndHeld) {
 // joint=value pair, a joint the file has no moving joint off the chain of, a value outside the
 // joint's limits or a joint given twice is a ConfigError at the setting's line naming the joint.
 TEST_F(ManipulatorTest, UrdfArmLumpsLinksOffTheChainWhereRpCfgSays) {
-  const std::string head = "[arm]\nclass UrdfManipulator\nurdf " RP_TEST_MODEL_DATA "/jaw_arm.urdf\noffChainPositions ";
+  const std::string head = "[arm]\nclass UrdfManipulator\nurdf " + RP_TEST_MODEL_DATA + "/jaw_arm.urdf\noffChainPositions ";
   RoboticPlatform::setConfiguration(Configuration::parse(head + "jointGripper=-45\n", "rp.cfg"));
   ObjectManager om;
   Manipulator* arm = om.createDerivedObject<Manipulator>("arm");
   UrdfOptions options;
   options.offChainPositions["jointGripper"] = -std::numbers::pi / 4;
-  const std::unique_ptr<ManipulatorModel> expected = loadUrdf(RP_TEST_MODEL_DATA "/jaw_arm.urdf", options);
-  const std::unique_ptr<ManipulatorModel> closed = loadUrdf(RP_TEST_MODEL_DATA "/jaw_arm.urdf");
+  const std::unique_ptr<ManipulatorModel> expected = loadUrdf(RP_TEST_MODEL_DATA + "/jaw_arm.urdf", options);
+  const std::unique_ptr<ManipulatorModel> closed = loadUrdf(RP_TEST_MODEL_DATA + "/jaw_arm.urdf");
   ASSERT_EQ(arm->getNumberOfJoints(), 6);
   const LinkParameters &got = arm->getModel().getLink(5), &want = expected->getLink(5);
   EXPECT_LT((Eigen::Vector3d(got.com) - Eigen::Vector3d(want.com)).norm(), 1e-15);

@@ -67,7 +67,7 @@ std::unique_ptr<ManipulatorModel> makeModel(int which) {
   UrdfOptions o;
   o.tip = "tool";
   o.requireDynamics = true;
-  std::unique_ptr<ManipulatorModel> prismatic = loadUrdf(RP_TEST_MODEL_DATA "/prismatic_arm.urdf", o);
+  std::unique_ptr<ManipulatorModel> prismatic = loadUrdf(RP_TEST_MODEL_DATA + "/prismatic_arm.urdf", o);
   if (which == 4) return prismatic;  // the Placement form
   return test::toModifiedDh(*test::prismaticDhArm());
 }

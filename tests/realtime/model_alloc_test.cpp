@@ -122,7 +122,7 @@ void expectUrdfArmDoesNotAllocate(const std::string& file, const std::string& ti
   UrdfOptions options;
   options.tip = tip;
   options.requireDynamics = true;
-  const std::unique_ptr<ManipulatorModel> arm = loadUrdf(std::string(RP_TEST_MODEL_DATA "/") + file, options);
+  const std::unique_ptr<ManipulatorModel> arm = loadUrdf(RP_TEST_MODEL_DATA + "/" + file, options);
   const int n = arm->getNumberOfJoints();
   ManipulatorData d(*arm);
   JointVector q(n), qd(n), qdd(n), out(n);
@@ -161,7 +161,7 @@ TEST(ModelRealtime, UrdfArmAlgorithmsDoNotAllocate) { expectUrdfArmDoesNotAlloca
 // in the data's own storage.
 TEST(ModelRealtime, MimicArmAlgorithmsDoNotAllocate) {
   expectUrdfArmDoesNotAllocate("mimic_arm.urdf", "tool");
-  ASSERT_TRUE(loadUrdf(RP_TEST_MODEL_DATA "/mimic_arm.urdf")->hasMimicJoints());
+  ASSERT_TRUE(loadUrdf(RP_TEST_MODEL_DATA + "/mimic_arm.urdf")->hasMimicJoints());
 }
 
 }  // namespace
