@@ -21,6 +21,7 @@
 #include "rp/rt/Clock.hpp"
 #include "rp/trajectory/TrajectoryGenerator.hpp"
 #include "../model/ChainInternal.hpp"
+#include "../model/ThreadWorkspace.hpp"
 #include "LinkShapes.hpp"
 #include "SeqlockHandover.hpp"
 
@@ -1127,7 +1128,10 @@ void DefaultManipulator::holdTorque() {
 }
 
 void DefaultManipulator::gravityWithPayload() {
-  gravityTorque(*model_, *data_, q_, gravity_);
+  // In this thread's workspace (ThreadWorkspace.hpp: an arm's own data is cold by its next cycle
+  // when an executor steps many arms), or the arm's own data with mimic joints.
+  ManipulatorData& d = internal::workspaceOr(*model_, *data_);
+  gravityTorque(*model_, d, q_, gravity_);
   std::array<double, 4> v{};
   if (payload_->handover.tryLoad(v)) {  // being changed: the next cycle takes it
     payloadMass_ = v[0];
@@ -1136,11 +1140,11 @@ void DefaultManipulator::gravityWithPayload() {
   if (payloadMass_ == 0) return;
   // The weight W = m g at the centre p: the torque that holds it is -J_p^T W, J_p's columns the
   // end-effector's (Jv_j + Jw_j x (p - e)).
-  // gravityTorque() above left the forward kinematics of q_ in data_: the Jacobian from them,
+  // gravityTorque() above left the forward kinematics of q_ in d: the Jacobian from them,
   // without computing them again in this cycle.
-  internal::jacobianFromKinematics(*model_, *data_);
-  const Jacobian& J = data_->jacobian;
-  const Transform& e = data_->endEffector;
+  internal::jacobianFromKinematics(*model_, d);
+  const Jacobian& J = d.jacobian;
+  const Transform& e = d.endEffector;
   const Eigen::Vector3d r = e.topLeftCorner<3, 3>() * Eigen::Vector3d(payloadCentre_);
   const Eigen::Vector3d weight = payloadMass_ * Eigen::Vector3d(model_->getGravity());
   for (int j = 0; j < gravity_.size(); ++j)

@@ -2,6 +2,7 @@
 #include "rp/manipulator/ManipulatorSimulation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "../model/ThreadWorkspace.hpp"
 #include "SeqlockHandover.hpp"
 #include "rp/core/Configuration.hpp"
 
@@ -123,26 +125,34 @@ std::unique_ptr<const ManipulatorModel> buildUnitPayload(const ManipulatorModel&
 }
 
 // Solves A x = b for a symmetric positive definite A by Cholesky (A = L L^T), without allocation.
+// Each diagonal entry of L is inverted once: n divisions instead of n (n + 3) / 2 (a division
+// takes as long as a dozen multiplications in a row).
 void choleskySolve(const JointMatrix& A, const JointVector& b, JointMatrix& L, JointVector& x) {
   const auto n = static_cast<int>(A.rows());
+  std::array<double, kMaxJoints> inverse;  // 1 / L(j, j) (each written before read)
   for (int j = 0; j < n; ++j) {
     double d = A(j, j);
     for (int m = 0; m < j; ++m) d -= L(j, m) * L(j, m);
-    L(j, j) = std::sqrt(d);
+    const double ljj = std::sqrt(d);
+    const double r = 1.0 / ljj;
+    L(j, j) = ljj;
+    inverse[static_cast<std::size_t>(j)] = r;
     for (int i = j + 1; i < n; ++i) {
       double s = A(i, j);
       for (int m = 0; m < j; ++m) s -= L(i, m) * L(j, m);
-      L(i, j) = s / L(j, j);
+      L(i, j) = s * r;
     }
   }
   x = b;
   for (int i = 0; i < n; ++i) {
-    for (int m = 0; m < i; ++m) x(i) -= L(i, m) * x(m);
-    x(i) /= L(i, i);
+    double s = x(i);
+    for (int m = 0; m < i; ++m) s -= L(i, m) * x(m);
+    x(i) = s * inverse[static_cast<std::size_t>(i)];
   }
   for (int i = n - 1; i >= 0; --i) {
-    for (int m = i + 1; m < n; ++m) x(i) -= L(m, i) * x(m);
-    x(i) /= L(i, i);
+    double s = x(i);
+    for (int m = i + 1; m < n; ++m) s -= L(m, i) * x(m);
+    x(i) = s * inverse[static_cast<std::size_t>(i)];
   }
 }
 
@@ -157,21 +167,24 @@ std::uint64_t contactMode(const JointVector& v) noexcept {
 
 // The friction problem of ManipulatorSimulation::solveFriction() (A, rhs, friction bounds upper
 // and lower) solved exactly in the contact mode of v, which it replaces if that solution is the
-// minimiser. L and x are scratch. Real-time safe: yes.
+// minimiser. Its scratch is on the stack, which stays in the level-1 cache from one arm to the
+// next (an arm's own memory is cold by its next cycle). Real-time safe: yes.
 bool solveContactMode(const JointMatrix& A, const JointVector& rhs, const JointVector& upper,
-                      const JointVector& lower, JointMatrix& L, JointVector& x, JointVector& v) noexcept {
+                      const JointVector& lower, JointVector& v) noexcept {
   // In the mode of v, the sliding joints s feel their friction c_s (upper forward, -lower
   // backward) and the others are at rest, so A_ss v_s = rhs_s - c_s. That v is the minimiser if
   // it keeps the mode (each v_s strictly in its direction) and the torque that holds each joint
   // at rest, rhs_i - (A v)_i, is within its friction [-lower_i, upper_i]: the optimality
   // conditions of the (strictly convex) problem. Otherwise nothing changes.
   const int n = static_cast<int>(v.size());
-  std::array<int, kMaxJoints> s{};
+  std::array<int, kMaxJoints> s;  // the sliding joints, s[0..m)
   int m = 0;
   for (int i = 0; i < n; ++i)
     if (v(i) != 0) s[static_cast<std::size_t>(m++)] = i;
   JointMatrix As(m, m);  // A_ss (fixed capacity: no allocation)
   JointVector bs(m);     // rhs_s - c_s
+  JointMatrix L(m, m);   // A_ss = L L^T
+  JointVector x(m);      // v_s
   for (int a = 0; a < m; ++a) {
     const int i = s[static_cast<std::size_t>(a)];
     bs(a) = rhs(i) - (v(i) > 0 ? upper(i) : -lower(i));
@@ -275,20 +288,25 @@ void ManipulatorSimulation::takePayload() noexcept {
   stepMass_ = stepCentre_ < 0 ? 0.0 : v[0];
 }
 
+// The step's forward dynamics go to this thread's workspace (ThreadWorkspace.hpp: with many arms
+// in one thread, an arm's own data is cold by its next step), or with mimic joints to the
+// simulation's own data: internal::workspaceOr(model_, data_) says which, to the step that reads
+// the results right after.
 void ManipulatorSimulation::dynamics(const JointVector& tau) {
+  ManipulatorData& d = internal::workspaceOr(model_, data_);
   if (stepMass_ == 0) {
-    forwardDynamics(model_, data_, q_, qd_, tau, options_);
+    forwardDynamics(model_, d, q_, qd_, tau, options_);
     return;
   }
   // (M + m M_u) qdd = tau - h - m h_u: the arm's forward dynamics under tau - m h_u gives M and
   // M qdd' = tau - h - m h_u, which is the right-hand side.
   Payload::Unit& u = payload_->units[static_cast<std::size_t>(stepCentre_)];
   payloadBias_ = tau - stepMass_ * inverseDynamics(*u.model, *u.data, q_, qd_, zero_);
-  forwardDynamics(model_, data_, q_, qd_, payloadBias_, options_);
-  payloadBias_.noalias() = data_.massMatrix * data_.qdd;
-  payloadMass_ = data_.massMatrix + stepMass_ * massMatrix(*u.model, *u.data, q_);
-  choleskySolve(payloadMass_, payloadBias_, L_, data_.qdd);
-  data_.massMatrix = payloadMass_;
+  forwardDynamics(model_, d, q_, qd_, payloadBias_, options_);
+  payloadBias_.noalias() = d.massMatrix * d.qdd;
+  payloadMass_ = d.massMatrix + stepMass_ * massMatrix(*u.model, *u.data, q_);
+  choleskySolve(payloadMass_, payloadBias_, L_, d.qdd);
+  d.massMatrix = payloadMass_;
 }
 
 const JointMatrix& ManipulatorSimulation::plantMassMatrix() {
@@ -455,7 +473,8 @@ void ManipulatorSimulation::eulerStep(double h) {
     tauTotal_(i) += k * ((q_(i) > hi || next > hi ? hi : lo) - q_(i));
   }
   dynamics(tauTotal_);
-  const JointMatrix& M = data_.massMatrix;
+  const ManipulatorData& d = internal::workspaceOr(model_, data_);
+  const JointMatrix& M = d.massMatrix;
   for (int i = 0; i < n; ++i) {
     diag_(i) = viscous_(i);
     // A stop critically damped for the joint's inertia at the stop.
@@ -463,20 +482,26 @@ void ManipulatorSimulation::eulerStep(double h) {
   }
   // qdd0 with the viscous torque at the start of the step (what getAcceleration() reports), so
   // the right-hand side adds it back: M (v + h qdd0) + h b v.
-  qdd_ = data_.qdd;
+  qdd_ = d.qdd;
   v0_ = qd_ + h * qdd_;
   rhs_.noalias() = M * v0_;
   rhs_ += h * viscous_.cwiseProduct(qd_);
   A_ = M;
   for (int i = 0; i < n; ++i) A_(i, i) += h * diag_(i);
-  // v* = A^-1 rhs by Cholesky (A is positive definite); without implicit terms v* = v0 exactly.
-  if (diag_.cwiseAbs().maxCoeff() > 0) {
+  if (hasCoulomb_ || brakes_) {
+    // The friction problem's solution is exact from any start (solveFriction() ends with the
+    // exact solution of its contact mode): it starts from v0, whose residual A v0 - rhs =
+    // h (diag v0 - b v) takes no product with A, and the step factorizes no matrix of its own.
+    for (int i = 0; i < n; ++i) residual_(i) = h * (diag_(i) * v0_(i) - viscous_(i) * qd_(i));
+    qd_ = v0_;
+    solveFriction(h);
+  } else if (diag_.cwiseAbs().maxCoeff() > 0) {
+    // v* = A^-1 rhs by Cholesky (A is positive definite).
     choleskySolve(A_, rhs_, L_, kv_);
+    qd_ = kv_;
   } else {
-    kv_ = v0_;
+    qd_ = v0_;  // without implicit terms v* = v0 exactly
   }
-  qd_ = kv_;
-  if (hasCoulomb_ || brakes_) solveFriction(h);
   q_ += h * qd_;
 }
 
@@ -494,7 +519,7 @@ void ManipulatorSimulation::rk4Step(double h) {
     tauTotal_ = tauApplied_ - viscous_.cwiseProduct(qd_);
     dynamics(tauTotal_);
     kq_ = qd_;
-    kv_ = data_.qdd;
+    kv_ = internal::workspaceOr(model_, data_).qdd;
     if (s == 0) qdd_ = kv_;
     const double w = (s == 0 || s == 3) ? 1.0 : 2.0;
     sumQ_ += w * kq_;
@@ -508,8 +533,9 @@ void ManipulatorSimulation::rk4Step(double h) {
   q_ = q0_ + (h / 6.0) * sumQ_;
   qd_ = v0_ + (h / 6.0) * sumV_;
   if (hasCoulomb_ || brakes_) {
-    A_ = data_.massMatrix;  // at the last stage (q0 + h v3), the end of the step to first order
+    A_ = internal::workspaceOr(model_, data_).massMatrix;  // at the last stage (q0 + h v3), the end of the step to first order
     rhs_.noalias() = A_ * qd_;
+    residual_.setZero();  // A qd - rhs
     kv_ = qd_;
     solveFriction(h);
     for (int i = 0; i < n; ++i) q_(i) = (v0_(i) == 0 && qd_(i) == 0) ? q0_(i) : q_(i) + 0.5 * h * (qd_(i) - kv_(i));
@@ -518,8 +544,8 @@ void ManipulatorSimulation::rk4Step(double h) {
 
 void ManipulatorSimulation::solveFriction(double h) {
   // Minimise 1/2 v^T A v - rhs^T v + h sum_i f_i(v_i), f_i(v) = F+ v (v > 0), -F- v (v < 0), by
-  // exact coordinate descent from the frictionless solution in qd_: each coordinate's minimiser is
-  // a soft threshold. The objective is strictly convex, so the sweeps converge to its minimiser;
+  // exact coordinate descent from the start in qd_ (its residual A qd_ - rhs in residual_, which
+  // the caller sets): each coordinate's minimiser is a soft threshold. The objective is strictly convex, so the sweeps converge to its minimiser;
   // a joint whose holding torque is within its friction comes out exactly at rest.
   const int n = model_.getNumberOfJoints();
   for (int i = 0; i < n; ++i) {
@@ -527,8 +553,6 @@ void ManipulatorSimulation::solveFriction(double h) {
     upper_(i) = h * (coulombPos_(i) + brake);
     lower_(i) = h * (coulombNeg_(i) + brake);
   }
-  residual_.noalias() = A_ * qd_;
-  residual_ -= rhs_;
   std::uint64_t lastMode = contactMode(qd_), triedMode = ~std::uint64_t{0};
   for (int sweep = 0; sweep < kMaxFrictionSweeps; ++sweep) {
     double change = 0;
@@ -557,7 +581,7 @@ void ManipulatorSimulation::solveFriction(double h) {
     // failing (its solution depends on the mode alone).
     const std::uint64_t mode = contactMode(qd_);
     if ((sweep == 0 || mode == lastMode) && mode != triedMode) {
-      if (solveContactMode(A_, rhs_, upper_, lower_, L_, kq_, qd_)) break;
+      if (solveContactMode(A_, rhs_, upper_, lower_, qd_)) break;
       triedMode = mode;
     }
     lastMode = mode;

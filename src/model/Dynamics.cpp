@@ -16,6 +16,7 @@
 // tests compare each with the recursion above, with KDL and with finite differences.
 #include "rp/model/Dynamics.hpp"
 
+#include <array>
 #include <cmath>
 
 #include "ChainInternal.hpp"
@@ -397,27 +398,39 @@ void velocityProductTorques(const ManipulatorModel& model, ManipulatorData& data
 }
 
 // M = L D L^T in place in data.ldl (M is symmetric positive definite: no pivoting), then
-// x <- M^-1 x by forward substitution, division by D and back substitution. O(n^3 / 6).
+// x <- M^-1 x by forward substitution, division by D and back substitution. O(n^3 / 6). Row j's
+// products L(j, k) D(k) are formed once for the whole column below it, and each D(j) is inverted
+// once (n divisions instead of n (n + 1) / 2).
 void ldlSolveInPlace(ManipulatorData& data, JointVector& x) {
   const int n = data.n;
   JointMatrix& L = data.ldl;
   const JointMatrix& M = data.massMatrix;
+  std::array<double, kMaxJoints> inverse, ld;  // 1 / D(j); L(j, k) D(k) of the row being done
   for (int j = 0; j < n; ++j) {
     double d = M(j, j);
-    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k) * L(k, k);
+    for (int k = 0; k < j; ++k) {
+      const double l = L(j, k) * L(k, k);
+      ld[static_cast<std::size_t>(k)] = l;
+      d -= L(j, k) * l;
+    }
     L(j, j) = d;
+    const double r = 1.0 / d;
+    inverse[static_cast<std::size_t>(j)] = r;
     for (int i = j + 1; i < n; ++i) {
       double s = M(i, j);
-      for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k) * L(k, k);
-      L(i, j) = s / d;
+      for (int k = 0; k < j; ++k) s -= L(i, k) * ld[static_cast<std::size_t>(k)];
+      L(i, j) = s * r;
     }
   }
-  for (int i = 0; i < n; ++i) {
-    for (int k = 0; k < i; ++k) x(i) -= L(i, k) * x(k);
+  for (int i = 0; i < n; ++i) {  // L y = x
+    double s = x(i);
+    for (int k = 0; k < i; ++k) s -= L(i, k) * x(k);
+    x(i) = s;
   }
-  for (int i = 0; i < n; ++i) x(i) /= L(i, i);
-  for (int i = n - 1; i >= 0; --i) {
-    for (int k = i + 1; k < n; ++k) x(i) -= L(k, i) * x(k);
+  for (int i = n - 1; i >= 0; --i) {  // L^T x = D^-1 y
+    double s = x(i) * inverse[static_cast<std::size_t>(i)];
+    for (int k = i + 1; k < n; ++k) s -= L(k, i) * x(k);
+    x(i) = s;
   }
 }
 
