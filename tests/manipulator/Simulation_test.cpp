@@ -14,6 +14,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -780,6 +781,81 @@ TEST(SimulationRealTime, SteppingDoesNotAllocate) {
     }
     EXPECT_EQ(guard.count(), 0u);
     EXPECT_GT(sim->getLastSubsteps(), 0);
+  }
+}
+
+// Many arms in one thread share one workspace for their steps' forward dynamics (an arm's own
+// data is cold by its next cycle when an executor steps hundreds). Arms of 6, 7 and 4 joints and a
+// second Puma with heavier links, stepped in turn in one thread, each under its own torques: every
+// state of every step must be bit for bit the one the arm reaches stepped on its own, and the
+// turns (which make the workspace again for each new number of joints) allocate nothing.
+TEST(SimulationRealTime, ArmsSteppedInTurnInOneThreadMoveAsEachAlone) {
+  const Puma560Model puma;
+  const WAM7Model wam7;
+  const WAM4Model wam4;
+  const Configuration heavy = Configuration::parse("[puma]\nclass Puma560\nsimMassScale 1.3\n", "rp.cfg");
+  constexpr int kSteps = 300;
+  for (SimulationIntegrator integrator : {SimulationIntegrator::Euler, SimulationIntegrator::RK4}) {
+    auto make = [&] {
+      std::vector<std::unique_ptr<ManipulatorSimulation>> arms;
+      arms.push_back(std::make_unique<ManipulatorSimulation>(puma));
+      arms.push_back(std::make_unique<ManipulatorSimulation>(wam7));
+      arms.push_back(makeSimulation(puma, &section(heavy)));
+      arms.push_back(std::make_unique<ManipulatorSimulation>(wam4));
+      for (auto& a : arms) a->setIntegrator(integrator);
+      return arms;
+    };
+    // Torques that move every joint of arm a at step k (away from gravity's rest, through friction).
+    auto torque = [](int a, int k, int n) {
+      JointVector tau(n);
+      for (int i = 0; i < n; ++i) tau(i) = 3.0 * std::sin(0.02 * k + 0.7 * i + a);
+      return tau;
+    };
+    // Alone: each arm's whole run in a thread of its own (whose workspace no other arm uses).
+    std::vector<std::vector<JointVector>> alone(4);
+    {
+      auto arms = make();
+      for (int a = 0; a < 4; ++a) {
+        std::thread([&, a] {
+          ManipulatorSimulation& s = *arms[static_cast<std::size_t>(a)];
+          for (int k = 0; k < kSteps; ++k) {
+            s.step(torque(a, k, s.getModel().getNumberOfJoints()), 1e-3);
+            alone[static_cast<std::size_t>(a)].push_back(s.getTruePosition());
+            alone[static_cast<std::size_t>(a)].push_back(s.getTrueVelocity());
+          }
+        }).join();
+      }
+    }
+    // In turn: one step of each arm, then the next step.
+    auto arms = make();
+    std::vector<std::vector<JointVector>> torques(4);
+    for (int a = 0; a < 4; ++a)
+      for (int k = 0; k < kSteps; ++k)
+        torques[static_cast<std::size_t>(a)].push_back(
+            torque(a, k, arms[static_cast<std::size_t>(a)]->getModel().getNumberOfJoints()));
+    std::vector<JointVector> states(4 * 2 * kSteps);
+    for (JointVector& v : states) v = JointVector::Zero(7);
+    test::AllocationGuard guard;
+    for (int k = 0; k < kSteps; ++k) {
+      for (int a = 0; a < 4; ++a) {
+        ManipulatorSimulation& s = *arms[static_cast<std::size_t>(a)];
+        s.step(torques[static_cast<std::size_t>(a)][static_cast<std::size_t>(k)], 1e-3);
+        states[static_cast<std::size_t>((a * kSteps + k) * 2)] = s.getTruePosition();
+        states[static_cast<std::size_t>((a * kSteps + k) * 2 + 1)] = s.getTrueVelocity();
+      }
+    }
+    EXPECT_EQ(guard.count(), 0u);
+    for (int a = 0; a < 4; ++a) {
+      for (int k = 0; k < 2 * kSteps; ++k) {
+        const JointVector& expected = alone[static_cast<std::size_t>(a)][static_cast<std::size_t>(k)];
+        const JointVector& got = states[static_cast<std::size_t>(a * 2 * kSteps + k)];
+        ASSERT_TRUE(got == expected) << "arm " << a << (k % 2 ? " velocity" : " position") << " after step "
+                                     << k / 2 + 1 << ": " << got.transpose() << " alone " << expected.transpose();
+      }
+    }
+    // The arms moved: the comparison is not of resting arms.
+    for (int a = 0; a < 4; ++a)
+      EXPECT_GT((alone[static_cast<std::size_t>(a)].back()).cwiseAbs().maxCoeff(), 0.1) << "arm " << a;
   }
 }
 
