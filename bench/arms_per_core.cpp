@@ -25,6 +25,15 @@
 //
 // Each mode's result line begins `arms_per_core MODE N ...`.
 //
+// --criterion strict|cpu (default strict) is what a count must meet. strict: no overrun in the
+// window, as above. cpu: the arms' CPU fits the period, whatever the machine does to the wake-ups:
+// the process's CPU time per period (N x cpu_us_per_arm_cycle) is at most 90 % of the period and
+// the 99th percentile of the executors' cycle time (from the wake-up to the end of the cycle's last
+// phase) is under the period, with no arm error. On a virtual machine whose timer wake-ups are
+// late by milliseconds now and then (rp-latency shows it without any arm), strict finds no count
+// at all, and cpu says what one core computes at 1 kHz; on a machine fit for real time they agree.
+// Each trial line also gives exec_cycle_p99_us, that percentile.
+//
 // --mode spread (not part of `both`): one executor spread over CPUs 0 and 1
 // (ControlProgram::setExecutorCpus()), the process not pinned: arms per two cores, in one cycle.
 //
@@ -39,7 +48,7 @@
 //   cost N  cpu_us_per_arm_cycle C
 // What grows with N here is the memory the arms' cycles touch outgrowing the caches and the TLB.
 //
-// Usage: arms_per_core [--mode M] [--integrator I] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
+// Usage: arms_per_core [--mode M] [--integrator I] [--criterion C] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
 #include <sched.h>
 #include <unistd.h>
 #include <sys/resource.h>
@@ -87,6 +96,7 @@ struct Trial {
   int arms = 0;
   std::uint64_t overruns = 0, cycles = 0;
   double cycleP50 = 0, cycleP99 = 0, wakeupP99 = 0, wakeupMax = 0;
+  double executorCycleP99 = 0;  // the largest of the executors' cycle-time p99 [us]
   double cpuPerCycle = 0;  // process CPU time (user + system) per arm cycle in the window [us]
   bool realTime = false;
   bool errors = false;
@@ -135,6 +145,8 @@ Trial run(int n, double seconds) {
     }
   }
   result.cpuPerCycle = result.cycles > 0 ? 1e6 * (cpu1 - cpu0) / static_cast<double>(result.cycles) : 0;
+  for (const ExecutorStatistics& e : ControlProgram::getExecutorStatistics())
+    if (!e.programs.empty()) result.executorCycleP99 = std::max(result.executorCycleP99, e.cycleTime.p99);
   generators.clear();
   arms.clear();
   return result;
@@ -143,13 +155,21 @@ Trial run(int n, double seconds) {
 void print(const Trial& t, double seconds) {
   const double expected = t.arms * seconds * 1000.0;
   std::printf("N %4d  overruns %6llu  cycles %.1f %%  cycle_p50_us %5.1f  cycle_p99_us %6.1f  wakeup_p99_us %7.1f  "
-              "wakeup_max_us %8.1f  cpu_us_per_arm_cycle %5.2f%s\n",
+              "wakeup_max_us %8.1f  exec_cycle_p99_us %7.1f  cpu_us_per_arm_cycle %5.2f%s\n",
               t.arms, static_cast<unsigned long long>(t.overruns), 100.0 * static_cast<double>(t.cycles) / expected,
-              t.cycleP50, t.cycleP99, t.wakeupP99, t.wakeupMax, t.cpuPerCycle, t.errors ? "  (arm errors)" : "");
+              t.cycleP50, t.cycleP99, t.wakeupP99, t.wakeupMax, t.executorCycleP99, t.cpuPerCycle,
+              t.errors ? "  (arm errors)" : "");
   std::fflush(stdout);
 }
 
-bool good(const Trial& t) { return t.overruns == 0 && !t.errors; }
+bool cpuCriterion = false;  // --criterion cpu
+
+bool good(const Trial& t) {
+  if (t.errors) return false;
+  if (!cpuCriterion) return t.overruns == 0;
+  constexpr double kPeriodUs = 1000.0;
+  return t.arms * t.cpuPerCycle <= 0.9 * kPeriodUs && t.executorCycleP99 < kPeriodUs;
+}
 
 // A count passes if one of `tries` trials has no overrun: on a shared machine a single trial can
 // miss a deadline from a stall outside the process (the host, another process's interrupt), while
@@ -192,6 +212,13 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "arms_per_core: --integrator must be rk4 or euler\n");
         return 2;
       }
+    } else if (a == "--criterion") {
+      const std::string c = value();
+      if (c != "strict" && c != "cpu") {
+        std::fprintf(stderr, "arms_per_core: --criterion must be strict or cpu\n");
+        return 2;
+      }
+      cpuCriterion = c == "cpu";
     } else if (a == "--cpu") {
       cpu = std::atoi(value());
     } else if (a == "--seconds") {
@@ -207,7 +234,7 @@ int main(int argc, char** argv) {
       resolution = std::max(1, std::atoi(value()));
     } else {
       std::fprintf(stderr,
-                   "usage: arms_per_core [--mode shared|own|both|spread|cost] [--integrator rk4|euler] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
+                   "usage: arms_per_core [--mode shared|own|both|spread|cost] [--integrator rk4|euler] [--criterion strict|cpu] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
       return 2;
     }
   }
@@ -281,10 +308,11 @@ int main(int argc, char** argv) {
       }
       best = t;
     }
+    int hi = bad;  // the smallest count that failed
     if (bad == 0) {
-      std::printf("no overrun up to --max %d\n", max);
+      std::printf("every count up to --max %d passed\n", max);
     } else {
-      int lo = best.arms, hi = bad;  // lo good (0: none), hi bad
+      int lo = best.arms;  // lo good (0: none), hi bad
       while (hi - lo > resolution) {
         const int mid = lo + (hi - lo) / 2;
         const Trial t = attempt(mid, seconds, tries);
@@ -297,13 +325,15 @@ int main(int argc, char** argv) {
       }
     }
     if (best.arms == 0) {
-      std::printf("arms_per_core %s 0 (even %d arms missed deadlines)\n", m.c_str(), start);
+      std::printf("arms_per_core %s 0 (even %d arms failed: %s)\n", m.c_str(), hi,
+                  cpuCriterion ? "their CPU does not fit the period" : "they missed deadlines");
       continue;
     }
     std::printf("arms_per_core %s %d  cycle_p50_us %.1f  cycle_p99_us %.1f  wakeup_p99_us %.1f  wakeup_max_us %.1f  "
-                "cpu_us_per_arm_cycle %.2f  scheduling %s\n",
-                m.c_str(), best.arms, best.cycleP50, best.cycleP99, best.wakeupP99, best.wakeupMax, best.cpuPerCycle,
-                best.realTime ? "SCHED_FIFO" : "normal");
+                "exec_cycle_p99_us %.1f  cpu_us_per_arm_cycle %.2f  scheduling %s  criterion %s\n",
+                m.c_str(), best.arms, best.cycleP50, best.cycleP99, best.wakeupP99, best.wakeupMax,
+                best.executorCycleP99, best.cpuPerCycle, best.realTime ? "SCHED_FIFO" : "normal",
+                cpuCriterion ? "cpu" : "strict");
   }
   std::remove(config.c_str());
   return 0;
