@@ -24,6 +24,8 @@
 // 6. `override` on calculate() and `std::` where needed; the class is unchanged otherwise.
 // 7. The wall is drawn in the Scene Viewer: a `Wall` object, a thin box on the plane, on the side
 //    the arm must stay out of (not in the paper).
+// 8. At the end the DefaultPositionControl holds the arm where the push left it (not in the
+//    paper): floating, it drifted on into a joint stop while the program ended.
 #include "RoboticPlatform.hpp"
 
 #include <chrono>
@@ -148,6 +150,15 @@ int main(int argc, char* argv[]) {
   const Transform t = puma.getEndEffectorTransform();
   std::cout << "final end-effector position: " << t(0, 3) << " " << t(1, 3) << " " << t(2, 3) << std::endl;
   puma.clearExternalWrench();
+  // The push has set the arm moving, and floating under gravity compensation it would drift on
+  // into a joint stop while the program ends: the DefaultPositionControl takes over and holds it
+  // where it is (clearTrajectoryGenerator() asks for the hold), and after a run of --duration the
+  // arm gets half a second of robot time to come to rest before the program ends.
+  if (!ObjectManager::isShutdownRequested()) {
+    puma.clearTrajectoryGenerator();
+    puma.setServoControl(puma.getDefaultPositionControl());
+    if (duration >= 0) puma.runCycles(static_cast<std::uint64_t>(0.5 / puma.getPeriod() + 0.5));
+  }
   if (simClock != nullptr) simClock->resume();
   if (ObjectManager::isShutdownRequested()) {  // a fault, an emergency stop or Ctrl-C ended the motion
     std::cerr << "virtual_walls: stopped by a system shutdown: " << ObjectManager::getShutdownReason() << std::endl;

@@ -491,7 +491,8 @@ void ManipulatorSimulation::eulerStep(double h) {
   if (hasCoulomb_ || brakes_) {
     // The friction problem's solution is exact from any start (solveFriction() ends with the
     // exact solution of its contact mode): it starts from v0, whose residual A v0 - rhs =
-    // h (diag v0 - b v) takes no product with A, and the step factorizes no matrix of its own.
+    // h (diag v0 - b v) takes no product with A, and A itself is never factorized (only M, in
+    // the forward dynamics, and the contact mode's rows of A).
     for (int i = 0; i < n; ++i) residual_(i) = h * (diag_(i) * v0_(i) - viscous_(i) * qd_(i));
     qd_ = v0_;
     solveFriction(h);
@@ -533,7 +534,8 @@ void ManipulatorSimulation::rk4Step(double h) {
   q_ = q0_ + (h / 6.0) * sumQ_;
   qd_ = v0_ + (h / 6.0) * sumV_;
   if (hasCoulomb_ || brakes_) {
-    A_ = internal::workspaceOr(model_, data_).massMatrix;  // at the last stage (q0 + h v3), the end of the step to first order
+    // The mass matrix at the last stage (q0 + h v3), the end of the step to first order.
+    A_ = internal::workspaceOr(model_, data_).massMatrix;
     rhs_.noalias() = A_ * qd_;
     residual_.setZero();  // A qd - rhs
     kv_ = qd_;
@@ -545,8 +547,9 @@ void ManipulatorSimulation::rk4Step(double h) {
 void ManipulatorSimulation::solveFriction(double h) {
   // Minimise 1/2 v^T A v - rhs^T v + h sum_i f_i(v_i), f_i(v) = F+ v (v > 0), -F- v (v < 0), by
   // exact coordinate descent from the start in qd_ (its residual A qd_ - rhs in residual_, which
-  // the caller sets): each coordinate's minimiser is a soft threshold. The objective is strictly convex, so the sweeps converge to its minimiser;
-  // a joint whose holding torque is within its friction comes out exactly at rest.
+  // the caller sets): each coordinate's minimiser is a soft threshold. The objective is strictly
+  // convex, so the sweeps converge to its minimiser; a joint whose holding torque is within its
+  // friction comes out exactly at rest.
   const int n = model_.getNumberOfJoints();
   for (int i = 0; i < n; ++i) {
     const double brake = brakes_ ? brakeTorque_(i) : 0.0;
