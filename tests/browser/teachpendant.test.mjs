@@ -72,7 +72,17 @@ describe('rp-teachpendant', () => {
 
   it('cycles through all positions and refuses bad requests', async () => {
     await ctx.page.click('#cycle-all');
-    await waitInPage(ctx.page, () => window.rp.state.busy && window.rp.state.target === 'P2');
+    // The program's own state, read every 20 ms: the motion to P2 (0.1 rad) can end between two of
+    // the page's reads, 500 ms apart (under ASan on a loaded machine the page never saw it).
+    const sawP2 = await ctx.page.evaluate(async () => {
+      for (const end = Date.now() + 15000; Date.now() < end;) {
+        const s = JSON.parse((await window.rp.conn.message('teachpendant', 'read', '')).reply);
+        if (s.busy && s.target === 'P2') return true;
+        await new Promise((r) => setTimeout(r, 20));
+      }
+      return false;
+    });
+    assert.ok(sawP2, 'the cycle never moved to P2');
     await nearStored(1, 0.01);
     const bad = await ctx.page.evaluate(async () => {
       const out = [];
