@@ -498,8 +498,7 @@ void ManipulatorSimulation::eulerStep(double h) {
     solveFriction(h);
   } else if (diag_.cwiseAbs().maxCoeff() > 0) {
     // v* = A^-1 rhs by Cholesky (A is positive definite).
-    choleskySolve(A_, rhs_, L_, kv_);
-    qd_ = kv_;
+    choleskySolve(A_, rhs_, L_, qd_);
   } else {
     qd_ = v0_;  // without implicit terms v* = v0 exactly
   }
@@ -516,11 +515,12 @@ void ManipulatorSimulation::rk4Step(double h) {
   v0_ = qd_;
   sumQ_.setZero();
   sumV_.setZero();
+  const ManipulatorData& d = internal::workspaceOr(model_, data_);  // where dynamics() leaves its results
   for (int s = 0; s < 4; ++s) {
     tauTotal_ = tauApplied_ - viscous_.cwiseProduct(qd_);
     dynamics(tauTotal_);
     kq_ = qd_;
-    kv_ = internal::workspaceOr(model_, data_).qdd;
+    kv_ = d.qdd;
     if (s == 0) qdd_ = kv_;
     const double w = (s == 0 || s == 3) ? 1.0 : 2.0;
     sumQ_ += w * kq_;
@@ -535,7 +535,7 @@ void ManipulatorSimulation::rk4Step(double h) {
   qd_ = v0_ + (h / 6.0) * sumV_;
   if (hasCoulomb_ || brakes_) {
     // The mass matrix at the last stage (q0 + h v3), the end of the step to first order.
-    A_ = internal::workspaceOr(model_, data_).massMatrix;
+    A_ = d.massMatrix;
     rhs_.noalias() = A_ * qd_;
     residual_.setZero();  // A qd - rhs
     kv_ = qd_;
