@@ -399,8 +399,18 @@ std::string SceneState::buildFrame() {
     std::vector<Transform> poses(e.frames.size(), Transform::unit());
     if (e.manipulator && e.data) {
       const ManipulatorModel& model = e.manipulator->getModel();
-      JointVector q = e.manipulator->getJointPosition();
-      if (q.size() == model.getNumberOfJoints()) {
+      // The poses and the values of one frame come from one servo cycle: a DefaultManipulator's
+      // snapshot (q, qd, tau, power, ...) gives the joint positions the poses are computed from.
+      // Read apart, a moving arm's picture and its joint values would be a cycle or more apart.
+      const int n = model.getNumberOfJoints();
+      JointVector q;
+      if (hasState && snap.size == 3 * n + 3 && dynamic_cast<const DefaultManipulator*>(e.manipulator)) {
+        q.resize(n);
+        for (int i = 0; i < n; ++i) q(i) = snap.values[i];
+      } else {
+        q = e.manipulator->getJointPosition();
+      }
+      if (q.size() == n) {
         forwardKinematics(model, *e.data, q);
         for (std::size_t f = 0; f < e.frames.size(); ++f) {
           const std::string& name = e.frames[f];

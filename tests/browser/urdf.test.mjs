@@ -57,10 +57,19 @@ describe('URDF visuals of a UrdfManipulator', () => {
     // Move joints 1 and 2 through Joint Move; the visuals follow.
     for (const [joint, value] of [[0, 0.9], [1, -0.6]])
       await ctx.page.evaluate(([j, v]) => window.rp.conn.message('jointmove', 'setJoint', JSON.stringify({ joint: j, value: v })), [joint, value]);
-    await waitInPage(page, () => {
-      const f = window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'arm');
-      return Math.abs(f.values[0] - 0.9) < 0.01 && Math.abs(f.values[1] + 0.6) < 0.01;
-    }, undefined, 30000);
+    // While the arm moves, every frame's picture is where the URDF puts the link for that same
+    // frame's joint values (the poses and the values are of one servo cycle, not read apart).
+    let inMotion = 0;
+    for (const deadline = Date.now() + 30000; ;) {
+      const s = await sample(page);
+      const want = l3Origin(s.q);
+      for (let i = 0; i < 3; ++i) assert.ok(Math.abs(s.p[i] - want[i]) < 1e-6, `l3 at ${s.p} for joints ${s.q}, URDF says ${want}`);
+      if (Math.abs(s.q[0] - 0.9) < 0.01 && Math.abs(s.q[1] + 0.6) < 0.01) break;
+      if (Math.abs(s.q[0] - before.q[0]) > 0.01 || Math.abs(s.q[1] - before.q[1]) > 0.01) ++inMotion;
+      assert.ok(Date.now() < deadline, `the arm did not reach the joints typed in 30 s (at ${s.q})`);
+      await new Promise((r) => setTimeout(r, 20));
+    }
+    assert.ok(inMotion >= 3, `only ${inMotion} frames seen while the arm moved`);
     const moved = await sample(page);
     const want1 = l3Origin(moved.q);
     for (let i = 0; i < 3; ++i) assert.ok(Math.abs(moved.p[i] - want1[i]) < 1e-6, `l3 at ${moved.p}, URDF says ${want1}`);

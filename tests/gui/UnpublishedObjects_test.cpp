@@ -10,13 +10,13 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
-#include <cstring>
 #include <map>
 #include <memory>
 #include <string>
 #include <thread>
 
 #include "SceneState.hpp"
+#include "StateFrame.hpp"
 #include "rp/RoboticPlatform.hpp"
 
 namespace {
@@ -47,38 +47,9 @@ json objectNamed(const rp::internal::SceneState& s, const std::string& name) {
 
 // The base-frame pose of every object in a state frame, by scene index.
 std::map<std::uint32_t, rp::Transform> framePoses(const std::string& frame) {
-  std::size_t at = 0;
-  auto u32 = [&] {
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(static_cast<unsigned char>(frame[at + i])) << (8 * i);
-    at += 4;
-    return v;
-  };
-  auto f64 = [&] {
-    std::uint64_t bits = 0;
-    for (int i = 0; i < 8; ++i) bits |= static_cast<std::uint64_t>(static_cast<unsigned char>(frame[at + i])) << (8 * i);
-    at += 8;
-    double v;
-    std::memcpy(&v, &bits, 8);
-    return v;
-  };
-  EXPECT_EQ(u32(), rp::internal::kStateFrameMagic);
-  (void)u32();  // protocol
-  (void)u32();  // version
-  const std::uint32_t count = u32();
-  (void)f64();  // time
   std::map<std::uint32_t, rp::Transform> poses;
-  for (std::uint32_t k = 0; k < count; ++k) {
-    const std::uint32_t index = u32(), n = u32(), values = u32();
-    (void)u32();  // error
-    for (std::uint32_t p = 0; p < n; ++p) {
-      rp::Transform t;
-      for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) t(r, c) = f64();
-      if (p == 0) poses[index] = t;
-    }
-    at += 8 * values;
-  }
+  for (const rp::test::FrameObject& o : rp::test::decodeStateFrame(frame))
+    if (!o.poses.empty()) poses[o.index] = o.poses[0];
   return poses;
 }
 
