@@ -184,29 +184,44 @@ std::string valueName(const std::string& program, const LogVariableInfo& v, std:
 struct ControlProgram::Impl {
   explicit Impl(ControlProgram& p) : self(p) {}
   ControlProgram& self;
-  std::string name;
-  double rate = 1000.0;
-  int priority = 27;
-  int cpu = -1;
-  Clock* clock = nullptr;
+
+  // What the executor reads and writes of the program every cycle, together in the first cache
+  // lines: one executor steps hundreds of programs, and each line of a program it touches is one
+  // more to fetch per program and cycle.
+  // Loop thread only:
+  bool entered = false;          // enterControl() ran
+  bool joining = false;          // entered in the current cycle
+  std::uint64_t startTick = 0;   // simulated clock: the first tick it may run
+  std::uint64_t k = 0;           // cycles run in this run
+  std::int64_t cycleNs = 0;      // computation time in the current cycle
+  std::uint64_t nextTick = 0;    // simulated clock: the tick after the last one run (see firstSimulatedTick())
   std::uint64_t cycleLimit = 0;
-
-  // Lifecycle.
-  std::mutex lifecycle;
-  std::atomic<bool> running{false};
+  // Cycle state, read by other threads too.
   std::atomic<bool> stopRequested{false};
-  std::mutex endMutex;
-  std::condition_variable endCv;
-  bool ended = true;
-
-  // Cycle state.
+  std::atomic<bool> loopEnded{false};  // exitControl() ran (the executor no longer steps it)
+  std::atomic<bool> parametersChanged{false};  // a parameter's dirty flag may be set
   std::atomic<double> time{0};
   std::atomic<std::uint64_t> cycles{0};
   std::atomic<std::uint64_t> overruns{0};
   std::atomic<std::uint64_t> missed{0};  // deadlines skipped after overruns
   std::atomic<std::uint64_t> logSamples{0};
-  std::atomic<bool> realTime{false};
   internal::DurationStats latency, computation;
+  unsigned logEvery = 1;
+
+  std::string name;
+  double rate = 1000.0;
+  int priority = 27;
+  int cpu = -1;
+  Clock* clock = nullptr;
+
+  // Lifecycle.
+  std::mutex lifecycle;
+  std::atomic<bool> running{false};
+  std::mutex endMutex;
+  std::condition_variable endCv;
+  bool ended = true;
+
+  std::atomic<bool> realTime{false};
 
   // Log variables.
   struct LogVar {
@@ -215,7 +230,6 @@ struct ControlProgram::Impl {
     bool selected = true;
   };
   std::vector<LogVar> logVars;
-  unsigned logEvery = 1;
   std::size_t logBufferSize = 4096;
   LogWriter* writer = nullptr;
   bool writerSet = false;
@@ -305,17 +319,28 @@ struct ControlProgram::Impl {
   }
 
   // Real-time: applies parameter changes requested since the last cycle, tear-free.
+  // A cycle without a change reads one flag (parametersChanged), not each parameter's.
   void applyParameters() noexcept {
+    if (!parametersChanged.load(std::memory_order_relaxed)) return;
+    (void)parametersChanged.exchange(false, std::memory_order_acq_rel);
+    bool again = false;  // a change left for the next cycle
     for (auto& p : params) {
       if (!p->dirty.load(std::memory_order_acquire)) continue;
       const std::uint64_t s1 = p->seq.load(std::memory_order_acquire);
-      if (s1 & 1) continue;  // a writer is busy; try next cycle
+      if (s1 & 1) {  // a writer is busy; try next cycle
+        again = true;
+        continue;
+      }
       p->dirty.store(false, std::memory_order_relaxed);
       // Acquire loads keep the second sequence read after the element reads (no fence: GCC
       // rejects atomic_thread_fence under ThreadSanitizer).
       for (std::size_t i = 0; i < p->info.size; ++i) p->target[i] = p->pending[i].load(std::memory_order_acquire);
-      if (p->seq.load(std::memory_order_relaxed) != s1) p->dirty.store(true, std::memory_order_relaxed);
+      if (p->seq.load(std::memory_order_relaxed) != s1) {
+        p->dirty.store(true, std::memory_order_relaxed);
+        again = true;
+      }
     }
+    if (again) parametersChanged.store(true, std::memory_order_release);
   }
 
   // Throws std::out_of_range if a value is outside the parameter's range.
@@ -342,6 +367,7 @@ struct ControlProgram::Impl {
     for (std::size_t i = 0; i < values.size(); ++i) p.pending[i].store(values[i], std::memory_order_relaxed);
     p.seq.fetch_add(1, std::memory_order_release);
     p.dirty.store(true, std::memory_order_release);
+    parametersChanged.store(true, std::memory_order_release);  // after the parameter's own flag
   }
 
   // Real-time: the bookkeeping after a program's phases (QMotor's log, the log file's sample,
@@ -379,7 +405,6 @@ struct ControlProgram::Impl {
   // The first tick of a run on the simulated clock: the next multiple of the period, and after
   // the ticks of an earlier run (started again after a stop, the clock may not have moved on: its
   // first cycle would have the time of the last one).
-  std::uint64_t nextTick = 0;
   std::uint64_t firstSimulatedTick(const SimulatedClock& sim, std::uint64_t ticksPerCycle) const {
     const std::uint64_t now = (sim.getTick() + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle;
     return std::max(now, (nextTick + ticksPerCycle - 1) / ticksPerCycle * ticksPerCycle);
@@ -388,14 +413,7 @@ struct ControlProgram::Impl {
   // Executor: which thread steps the program, and its state in that thread.
   ThreadMode threadMode = ThreadMode::Shared;
   std::atomic<Executor*> executor{nullptr};  // set by start(), cleared by stop() (lifecycle mutex)
-  std::atomic<bool> loopEnded{false};         // exitControl() ran (the executor no longer steps it)
   std::size_t executorPrograms = 0;           // programs of the executor when it was last started
-  // Loop thread only:
-  bool entered = false;          // enterControl() ran
-  bool joining = false;          // entered in the current cycle
-  std::uint64_t startTick = 0;   // simulated clock: the first tick it may run
-  std::uint64_t k = 0;           // cycles run in this run
-  std::int64_t cycleNs = 0;      // computation time in the current cycle
 
   // Loop thread: before the first cycle.
   void enter() {
