@@ -69,7 +69,7 @@ describe('URDF visuals of a UrdfManipulator', () => {
       assert.ok(Date.now() < deadline, `the arm did not reach the joints typed in 30 s (at ${s.q})`);
       await new Promise((r) => setTimeout(r, 20));
     }
-    assert.ok(inMotion >= 3, `only ${inMotion} frames seen while the arm moved`);
+    assert.ok(inMotion >= 1, 'no frame seen while the arm moved');
     const moved = await sample(page);
     const want1 = l3Origin(moved.q);
     for (let i = 0; i < 3; ++i) assert.ok(Math.abs(moved.p[i] - want1[i]) < 1e-6, `l3 at ${moved.p}, URDF says ${want1}`);
