@@ -9,6 +9,7 @@
 #include <set>
 
 #include "../core/PhysicalObjectViews.hpp"
+#include "../manipulator/ArmSnapshot.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/effector/Gripper.hpp"
 #include "rp/gui/SceneViewer.hpp"
@@ -399,17 +400,13 @@ std::string SceneState::buildFrame() {
     std::vector<Transform> poses(e.frames.size(), Transform::unit());
     if (e.manipulator && e.data) {
       const ManipulatorModel& model = e.manipulator->getModel();
-      // The poses and the values of one frame come from one servo cycle: a DefaultManipulator's
-      // snapshot (q, qd, tau, power, ...) gives the joint positions the poses are computed from.
-      // Read apart, a moving arm's picture and its joint values would be a cycle or more apart.
+      // The poses and the values of one frame come from one servo cycle: the snapshot's joint
+      // positions, not a second read (a moving arm's picture and values would be cycles apart).
       const int n = model.getNumberOfJoints();
-      JointVector q;
-      if (hasState && snap.size == 3 * n + 3 && dynamic_cast<const DefaultManipulator*>(e.manipulator)) {
-        q.resize(n);
-        for (int i = 0; i < n; ++i) q(i) = snap.values[i];
-      } else {
-        q = e.manipulator->getJointPosition();
-      }
+      internal::ArmCycleState cycle;
+      const JointVector q = hasState && internal::armCycleState(*e.manipulator, snap, n, cycle)
+                                ? cycle.q
+                                : e.manipulator->getJointPosition();
       if (q.size() == n) {
         forwardKinematics(model, *e.data, q);
         for (std::size_t f = 0; f < e.frames.size(); ++f) {

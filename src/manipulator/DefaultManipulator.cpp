@@ -16,6 +16,7 @@
 #include "rp/io/HwServerIoBoard.hpp"
 #include "rp/ros2/Ros2IoBoard.hpp"
 #include "../ros2/Ros2Common.hpp"
+#include "ArmSnapshot.hpp"
 #include "rp/io/IoException.hpp"
 #include "rp/model/Kinematics.hpp"
 #include "rp/rt/Clock.hpp"
@@ -1269,7 +1270,7 @@ bool DefaultManipulator::getStateSnapshot(StateSnapshot& snapshot) const {
   snapshot.time = s.time;
   snapshot.readTime = s.readTime;
   snapshot.cycle = s.cycle;
-  snapshot.size = 3 * s.n + 3;
+  snapshot.size = internal::armSnapshotSize(s.n);  // the layout ArmSnapshot.hpp reads
   for (int i = 0; i < s.n; ++i) {
     snapshot.values[i] = s.q[i];
     snapshot.values[s.n + i] = s.qd[i];

@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../manipulator/ArmSnapshot.hpp"
 #include "../model/ExportFrames.hpp"
 #include "../rt/CycleSignal.hpp"
 #include "EffortCommandControl.hpp"
@@ -654,22 +655,21 @@ void Ros2Bridge::Impl::cycle() {
     const int n = model.getNumberOfJoints();
     // One consistent cycle of the servo loop (DefaultManipulator's snapshot: q, qd, tau, power).
     StateSnapshot snap;
+    internal::ArmCycleState cycle;
     JointVector q(n), qd(n), tau(n);
     bool power = m->isArmPowerOn();
     builtin_interfaces_msg_dds__Time_ stamp = publishedAt;
     bool fresh = true;  // a sample to write (at the servo rate: only of a servo cycle not yet written)
-    if (m->getStateSnapshot(snap) && snap.size >= 3 * n + 1) {
+    if (m->getStateSnapshot(snap) && internal::armCycleState(*m, snap, n, cycle)) {
       // At the servo rate, each sample of the joints once: a cycle that read an arm's hardware
       // sample again (its server late) keeps that sample's time and publishes nothing.
       const double held = snap.readTime > 0 ? snap.readTime : snap.time;
       fresh = !servo || held != e.lastTime;
       e.lastTime = held;
-      for (int i = 0; i < n; ++i) {
-        q(i) = snap.values[i];
-        qd(i) = snap.values[n + i];
-        tau(i) = snap.values[2 * n + i];
-      }
-      power = snap.values[3 * n] != 0;
+      q = cycle.q;
+      qd = cycle.qd;
+      tau = cycle.tau;
+      power = cycle.power;
       // Stamped with the time the cycle read the joints, as ros2_control's joint_state_broadcaster
       // stamps with the time of the controller manager's read.
       stamp = cycleStamp(*m, e.wall, snap.readTime > 0 ? snap.readTime : snap.time, publishedAt);

@@ -4,7 +4,6 @@
 // values would disagree by a cycle or more (seen in CI: the browser.urdf test's link 3 was 2 um
 // from where the frame's own joint values put it, on an arm still settling).
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <string>
 #include <vector>
@@ -16,8 +15,6 @@
 #include "rp/model/ManipulatorData.hpp"
 
 namespace {
-
-using nlohmann::json;
 
 // A Puma whose getJointPosition() answers a later cycle's position than its published state
 // (0.05 rad further on every joint), as when its servo loop runs a cycle between two reads.
@@ -31,19 +28,10 @@ class PumaAhead : public rp::Puma560 {
   }
 };
 
-// The scene description of the object named `name` and its index among the scene's objects.
-std::pair<json, std::uint32_t> describedObject(const rp::internal::SceneState& s, const std::string& name) {
-  const json scene = json::parse(s.sceneMessage());
-  for (std::size_t i = 0; i < scene["objects"].size(); ++i)
-    if (scene["objects"][i]["name"] == name) return {scene["objects"][i], static_cast<std::uint32_t>(i)};
-  ADD_FAILURE() << name << " is not in the scene: " << s.sceneMessage();
-  return {json(), 0};
-}
-
 // Checks every frame of `arm` in one state frame against the kinematics of the joint positions in
 // the same state frame's values; returns the number of frames compared.
 int expectPosesOfTheFramesValues(rp::internal::SceneState& scene, const rp::Manipulator& arm, const std::string& name) {
-  const auto [desc, index] = describedObject(scene, name);
+  const auto [desc, index] = rp::test::describedObject(scene, name);
   const std::vector<std::string> frames = desc["frames"].get<std::vector<std::string>>();
   const rp::ManipulatorModel& model = arm.getModel();
   const int n = model.getNumberOfJoints();
@@ -98,13 +86,12 @@ TEST(SceneFrames, AMovingArmsPosesAndValuesAreOfOneCycle) {
   rp::internal::SceneState scene;
   scene.refresh();
   int frames = 0;
-  double travelled = 0;
   const rp::JointVector start = puma.getJointPosition();
   while (!tragen.isDone() && frames < 20000 && !HasFailure()) {
     ASSERT_EQ(expectPosesOfTheFramesValues(scene, puma, "mover"), 7);
     ++frames;
   }
-  travelled = (puma.getJointPosition() - start).cwiseAbs().maxCoeff();
+  const double travelled = (puma.getJointPosition() - start).cwiseAbs().maxCoeff();
   EXPECT_GT(travelled, 0.1) << "the arm moved while the frames were built (" << frames << " frames)";
   EXPECT_EQ(puma.getErrorCode(), 0) << puma.getErrorStatus().message;
 }

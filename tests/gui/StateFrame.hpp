@@ -1,18 +1,31 @@
-// Reads the Scene Viewer's binary state frames (the layout SceneState::buildFrame() writes) in
-// the tests: each object's scene index, world poses and state values.
+// Reads what the Scene Viewer's SceneState sends, in the tests: an object's description in the
+// scene message, and the binary state frames (the layout SceneState::buildFrame() writes): each
+// object's scene index, world poses and state values.
 #pragma once
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "SceneState.hpp"
 #include "rp/math/Transform.hpp"
 
 namespace rp::test {
+
+/// The scene message's description of the object named `name` and its index among the scene's
+/// objects (the index state frames give); a test failure, null and 0 if there is none.
+inline std::pair<nlohmann::json, std::uint32_t> describedObject(const internal::SceneState& s, const std::string& name) {
+  const nlohmann::json scene = nlohmann::json::parse(s.sceneMessage());
+  for (std::size_t i = 0; i < scene["objects"].size(); ++i)
+    if (scene["objects"][i]["name"] == name) return {scene["objects"][i], static_cast<std::uint32_t>(i)};
+  ADD_FAILURE() << name << " is not in the scene: " << s.sceneMessage();
+  return {nullptr, 0};
+}
 
 /// One object of a state frame.
 struct FrameObject {

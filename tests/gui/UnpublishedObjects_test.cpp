@@ -38,26 +38,12 @@ class Fixture : public rp::PhysicalObject {
 RP_REGISTER_CLASS(Fixture);
 namespace {
 
-json objectNamed(const rp::internal::SceneState& s, const std::string& name) {
-  const json scene = json::parse(s.sceneMessage());
-  for (const json& o : scene["objects"])
-    if (o["name"] == name) return o;
-  return nullptr;
-}
-
 // The base-frame pose of every object in a state frame, by scene index.
 std::map<std::uint32_t, rp::Transform> framePoses(const std::string& frame) {
   std::map<std::uint32_t, rp::Transform> poses;
   for (const rp::test::FrameObject& o : rp::test::decodeStateFrame(frame))
     if (!o.poses.empty()) poses[o.index] = o.poses[0];
   return poses;
-}
-
-int indexOf(const rp::internal::SceneState& s, const std::string& name) {
-  const json scene = json::parse(s.sceneMessage());
-  for (std::size_t i = 0; i < scene["objects"].size(); ++i)
-    if (scene["objects"][i]["name"] == name) return static_cast<int>(i);
-  return -1;
 }
 
 TEST(UnpublishedObjects, ArePlacedAsRpCfgSaysAndFollowTheirMount) {
@@ -73,7 +59,7 @@ TEST(UnpublishedObjects, ArePlacedAsRpCfgSaysAndFollowTheirMount) {
 
   rp::internal::SceneState scene;
   scene.refresh();
-  const json t = objectNamed(scene, "table");
+  const json t = rp::test::describedObject(scene, "table").first;
   ASSERT_TRUE(t.is_object()) << scene.sceneMessage();
   EXPECT_EQ(t["kind"], "physical");
   EXPECT_EQ(t["published"], false);
@@ -81,16 +67,16 @@ TEST(UnpublishedObjects, ArePlacedAsRpCfgSaysAndFollowTheirMount) {
   ASSERT_EQ(t["shapes"].size(), 1u);
   EXPECT_EQ(t["shapes"][0]["kind"], "box");  // PhysicalObject's own look: a 0.1 m cube
   EXPECT_EQ(t["shapes"][0]["size"], json::array({0.1, 0.1, 0.1}));
-  const json m = objectNamed(scene, "tool");
+  const json m = rp::test::describedObject(scene, "tool").first;
   ASSERT_TRUE(m.is_object());
   EXPECT_EQ(m["connection"], (json{{"object", "puma"}, {"frame", "endEffector"}}));
 
   const std::map<std::uint32_t, rp::Transform> poses = framePoses(scene.buildFrame());
-  const auto tp = poses.find(static_cast<std::uint32_t>(indexOf(scene, "table")));
+  const auto tp = poses.find(rp::test::describedObject(scene, "table").second);
   ASSERT_NE(tp, poses.end()) << "the table has a pose in the state frames";
   const rp::Transform expectedTable = rp::translation(0.5, -0.1, 0.2) * rp::rpyToTransform(0, 0, M_PI / 2);
   EXPECT_LT((tp->second - expectedTable).cwiseAbs().maxCoeff(), 1e-12) << tp->second;
-  const auto mp = poses.find(static_cast<std::uint32_t>(indexOf(scene, "tool")));
+  const auto mp = poses.find(rp::test::describedObject(scene, "tool").second);
   ASSERT_NE(mp, poses.end());
   const rp::Transform expectedTool = puma.getEndEffectorTransform() * rp::translation(0, 0, 0.05);
   EXPECT_LT((mp->second - expectedTool).cwiseAbs().maxCoeff(), 1e-6) << mp->second << "\n" << expectedTool;
@@ -98,8 +84,8 @@ TEST(UnpublishedObjects, ArePlacedAsRpCfgSaysAndFollowTheirMount) {
   // Published later, it is described by its class as any published object.
   table.publishObject();
   scene.refresh();
-  EXPECT_EQ(objectNamed(scene, "table")["className"], "Fixture");
-  EXPECT_NE(objectNamed(scene, "table")["published"], false);
+  EXPECT_EQ(rp::test::describedObject(scene, "table").first["className"], "Fixture");
+  EXPECT_NE(rp::test::describedObject(scene, "table").first["published"], false);
   tool.clearConnection();
 }
 
