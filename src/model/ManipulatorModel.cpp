@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -59,28 +60,65 @@ PlacementAxes signedPermutation(const Transform& P) {
 
 }  // namespace
 
+namespace {
+
+// Whether two links are the same in every parameter (names included: they are the model's).
+bool sameLink(const LinkParameters& x, const LinkParameters& y) {
+  return x.a == y.a && x.alpha == y.alpha && x.d == y.d && x.offset == y.offset && x.mass == y.mass && x.com == y.com &&
+         x.inertia == y.inertia && x.motorInertia == y.motorInertia && x.gearRatio == y.gearRatio &&
+         x.viscousFriction == y.viscousFriction && x.coulombFrictionPositive == y.coulombFrictionPositive &&
+         x.coulombFrictionNegative == y.coulombFrictionNegative && x.positionMin == y.positionMin &&
+         x.positionMax == y.positionMax && x.velocityLimit == y.velocityLimit &&
+         x.accelerationLimit == y.accelerationLimit && x.jerkLimit == y.jerkLimit && x.torqueLimit == y.torqueLimit &&
+         x.type == y.type && x.placement == y.placement && x.jointName == y.jointName && x.linkName == y.linkName;
+}
+
+}  // namespace
+
+// Everything in Links follows from the links and the convention, so two models with equal links
+// and convention can share one. The registry holds weak references: a set of links no model uses
+// any more is freed with its last model. Only constructors call this (never a servo cycle).
+std::shared_ptr<const ManipulatorModel::Links> ManipulatorModel::internLinks(std::shared_ptr<Links> links,
+                                                                             DHConvention convention) {
+  static auto* mutex = new std::mutex;  // never destroyed: models may be made during static destruction
+  static auto* known = new std::vector<std::pair<DHConvention, std::weak_ptr<const Links>>>;
+  std::lock_guard<std::mutex> lock(*mutex);
+  known->erase(std::remove_if(known->begin(), known->end(), [](const auto& k) { return k.second.expired(); }), known->end());
+  for (const auto& [c, weak] : *known) {
+    if (c != convention) continue;
+    std::shared_ptr<const Links> other = weak.lock();
+    if (!other || other->links.size() != links->links.size()) continue;
+    if (std::equal(other->links.begin(), other->links.end(), links->links.begin(), sameLink)) return other;
+  }
+  known->emplace_back(convention, links);
+  return links;
+}
+
 ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters> links, const Transform& base,
                                    const Transform& tool, const Vector<3>& gravity, DHConvention convention)
     : name_(std::move(name)),
-      links_(std::move(links)),
       base_(base),
       tool_(tool),
       gravity_(gravity),
       convention_(convention) {
-  const int n = static_cast<int>(links_.size());
+  auto shared = std::make_shared<Links>();
+  Links& m = *shared;
+  m.links = std::move(links);
+  const int n = static_cast<int>(m.links.size());
   if (n < 1 || n > kMaxJoints) {
     throw std::invalid_argument("ManipulatorModel '" + name_ + "': " + std::to_string(n) +
                                 " links; a model has 1 to " + std::to_string(kMaxJoints));
   }
-  for (JointVector* v : {&qmin_, &qmax_, &vmax_, &amax_, &jmax_, &taumax_, &armature_, &home_, &cosAlpha_, &sinAlpha_}) v->setZero(n);
+  for (JointVector* v : {&m.qmin, &m.qmax, &m.vmax, &m.amax, &m.jmax, &m.taumax, &m.armature, &home_, &m.cosAlpha, &m.sinAlpha})
+    v->setZero(n);
   if (!base_.allFinite() || !tool_.allFinite() || !gravity_.allFinite())
     throw std::invalid_argument("ManipulatorModel '" + name_ + "': the base, tool or gravity is not finite");
   toolIsIdentity_ = tool_.isIdentity(0.0);
-  placements_.assign(static_cast<std::size_t>(n), Transform::unit());
-  placementAxes_.assign(static_cast<std::size_t>(n), PlacementAxes{});
+  m.placements.assign(static_cast<std::size_t>(n), Transform::unit());
+  m.placementAxes.assign(static_cast<std::size_t>(n), PlacementAxes{});
   std::unordered_set<std::string> jointNames, linkNames;
   for (int i = 0; i < n; ++i) {
-    LinkParameters& l = links_[static_cast<std::size_t>(i)];
+    LinkParameters& l = m.links[static_cast<std::size_t>(i)];
     std::string joint = "ManipulatorModel '" + name_ + "' joint " + std::to_string(i + 1);
     if (!l.jointName.empty()) {
       joint += " ('";
@@ -98,28 +136,28 @@ ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters>
         throw std::invalid_argument(joint + "DH parameters (a, alpha, d, offset) given with DHConvention::Placement");
       if (const std::string problem = rigidTransformError(l.placement); !problem.empty())
         throw std::invalid_argument(joint + "the placement is not a rigid transform: it " + problem);
-      placements_[static_cast<std::size_t>(i)] = l.placement;
+      m.placements[static_cast<std::size_t>(i)] = l.placement;
     } else {
       if (!l.placement.isIdentity(0.0))
         throw std::invalid_argument(joint + "a placement given with DH parameters (use DHConvention::Placement)");
-      if (convention_ == DHConvention::Modified) placements_[static_cast<std::size_t>(i)] = modifiedPlacement(l);
+      if (convention_ == DHConvention::Modified) m.placements[static_cast<std::size_t>(i)] = modifiedPlacement(l);
     }
-    placementAxes_[static_cast<std::size_t>(i)] = signedPermutation(placements_[static_cast<std::size_t>(i)]);
+    m.placementAxes[static_cast<std::size_t>(i)] = signedPermutation(m.placements[static_cast<std::size_t>(i)]);
     if (l.mass < 0) throw std::invalid_argument(joint + "negative mass");
     if (!(l.positionMin <= l.positionMax)) throw std::invalid_argument(joint + "position limits have min > max");
     if (!(l.velocityLimit > 0) || !(l.accelerationLimit > 0) || !(l.jerkLimit > 0) || !(l.torqueLimit > 0)) {
       throw std::invalid_argument(joint + "velocity, acceleration, jerk and torque limits must be positive");
     }
-    qmin_(i) = l.positionMin;
-    qmax_(i) = l.positionMax;
-    vmax_(i) = l.velocityLimit;
-    amax_(i) = l.accelerationLimit;
-    jmax_(i) = l.jerkLimit;
-    taumax_(i) = l.torqueLimit;
-    armature_(i) = l.gearRatio * l.gearRatio * l.motorInertia;
+    m.qmin(i) = l.positionMin;
+    m.qmax(i) = l.positionMax;
+    m.vmax(i) = l.velocityLimit;
+    m.amax(i) = l.accelerationLimit;
+    m.jmax(i) = l.jerkLimit;
+    m.taumax(i) = l.torqueLimit;
+    m.armature(i) = l.gearRatio * l.gearRatio * l.motorInertia;
     home_(i) = std::clamp(0.0, l.positionMin, l.positionMax);
-    cosAlpha_(i) = std::cos(l.alpha);
-    sinAlpha_(i) = std::sin(l.alpha);
+    m.cosAlpha(i) = std::cos(l.alpha);
+    m.sinAlpha(i) = std::sin(l.alpha);
     // The factor is used only where it gives the inertia back to rounding: a positive definite
     // tensor (Eigen's LLT does not check symmetry; the lower triangle is the one it reads).
     const Eigen::LLT<Eigen::Matrix3d> llt(l.inertia);
@@ -130,9 +168,10 @@ ManipulatorModel::ManipulatorModel(std::string name, std::vector<LinkParameters>
       const double scale = l.inertia.cwiseAbs().maxCoeff();
       valid = L.allFinite() && (L * L.transpose() - l.inertia).cwiseAbs().maxCoeff() <= 1e-14 * scale;
     }
-    inertiaFactors_.push_back(L);
-    inertiaFactorValid_.push_back(valid);
+    m.inertiaFactors.push_back(L);
+    m.inertiaFactorValid.push_back(valid);
   }
+  links_ = internLinks(std::move(shared), convention_);
 }
 
 namespace {
@@ -230,9 +269,11 @@ int ManipulatorModel::findJoint(const std::string& name) const {
 }
 
 bool ManipulatorModel::isWithinLimits(const JointVector& q) const {
-  if (q.size() != qmin_.size()) return false;
+  const JointVector& qmin = links_->qmin;
+  const JointVector& qmax = links_->qmax;
+  if (q.size() != qmin.size()) return false;
   for (Eigen::Index i = 0; i < q.size(); ++i) {
-    if (!(q(i) >= qmin_(i) && q(i) <= qmax_(i))) return false;
+    if (!(q(i) >= qmin(i) && q(i) <= qmax(i))) return false;
   }
   return true;
 }

@@ -161,9 +161,9 @@ class ManipulatorModel {
   /// Robot name. Real-time safe: yes.
   const std::string& getName() const { return name_; }
   /// Number of joints. Real-time safe: yes.
-  int getNumberOfJoints() const { return static_cast<int>(links_.size()); }
+  int getNumberOfJoints() const { return static_cast<int>(links_->links.size()); }
   /// Parameters of joint/link `i` (from 0). Real-time safe: yes.
-  const LinkParameters& getLink(int i) const { return links_[static_cast<std::size_t>(i)]; }
+  const LinkParameters& getLink(int i) const { return links_->links[static_cast<std::size_t>(i)]; }
   /// DH convention. Real-time safe: yes.
   DHConvention getConvention() const { return convention_; }
   /// Name of joint `i` (from 0): the URDF joint name, or `joint1`, `joint2`, ... Real-time safe: yes.
@@ -178,10 +178,10 @@ class ManipulatorModel {
   /// (\f$R_x(\alpha) T_x(a) R_z(\mathrm{offset}) T_z(d)\f$) and Placement conventions; for
   /// standard DH, whose fixed parts lie on both sides of the motion, the unit transform.
   /// Real-time safe: yes.
-  const Transform& getPlacement(int i) const { return placements_[static_cast<std::size_t>(i)]; }
+  const Transform& getPlacement(int i) const { return links_->placements[static_cast<std::size_t>(i)]; }
   /// The rotation of getPlacement(i) as a signed permutation of the axes, when it is one (see
   /// PlacementAxes; modified DH and Placement conventions). Real-time safe: yes.
-  const PlacementAxes& getPlacementAxes(int i) const { return placementAxes_[static_cast<std::size_t>(i)]; }
+  const PlacementAxes& getPlacementAxes(int i) const { return links_->placementAxes[static_cast<std::size_t>(i)]; }
   /// Whether joint `i` (from 0) is prismatic. Real-time safe: yes.
   bool isPrismatic(int i) const { return getLink(i).type == JointType::Prismatic; }
   /// Pose of the base in the world [m]. Real-time safe: yes.
@@ -195,33 +195,33 @@ class ManipulatorModel {
   const Vector<3>& getGravity() const { return gravity_; }
 
   /// Lower joint limits [rad] (numberOfJoints x 1). Real-time safe: yes.
-  const JointVector& getPositionMin() const { return qmin_; }
+  const JointVector& getPositionMin() const { return links_->qmin; }
   /// Upper joint limits [rad]. Real-time safe: yes.
-  const JointVector& getPositionMax() const { return qmax_; }
+  const JointVector& getPositionMax() const { return links_->qmax; }
   /// Joint speed limits [rad/s]. Real-time safe: yes.
-  const JointVector& getVelocityLimit() const { return vmax_; }
+  const JointVector& getVelocityLimit() const { return links_->vmax; }
   /// Joint acceleration limits for trajectories [rad/s^2]. Real-time safe: yes.
-  const JointVector& getAccelerationLimit() const { return amax_; }
+  const JointVector& getAccelerationLimit() const { return links_->amax; }
   /// Joint jerk limits for trajectories [rad/s^3]. Real-time safe: yes.
-  const JointVector& getJerkLimit() const { return jmax_; }
+  const JointVector& getJerkLimit() const { return links_->jmax; }
   /// Joint torque limits [N m]. Real-time safe: yes.
-  const JointVector& getTorqueLimit() const { return taumax_; }
+  const JointVector& getTorqueLimit() const { return links_->taumax; }
   /// Reflected motor inertia \f$G^2 J_m\f$ per joint [kg m^2]. Real-time safe: yes.
-  const JointVector& getArmatureInertia() const { return armature_; }
+  const JointVector& getArmatureInertia() const { return links_->armature; }
   /// Whether `q` lies within the joint limits (inclusive). Real-time safe: yes.
   bool isWithinLimits(const JointVector& q) const;
 
   /// \f$\cos\alpha_i\f$ of every link (precomputed for the algorithms). Real-time safe: yes.
-  const JointVector& getCosAlpha() const { return cosAlpha_; }
+  const JointVector& getCosAlpha() const { return links_->cosAlpha; }
   /// \f$\sin\alpha_i\f$ of every link (precomputed for the algorithms). Real-time safe: yes.
-  const JointVector& getSinAlpha() const { return sinAlpha_; }
+  const JointVector& getSinAlpha() const { return links_->sinAlpha; }
   /// Link `i`'s rotational inertia about its centre of mass as \f$L L^T\f$, L lower triangular
   /// (its Cholesky factor, precomputed for the mass matrix: \f$R I_c R^T = (R L)(R L)^T\f$ costs
   /// half the products of the plain form), or nullptr where the inertia is not positive definite
   /// (a point mass, a massless link). Real-time safe: yes.
   const Eigen::Matrix3d* getInertiaFactor(int i) const {
     const auto k = static_cast<std::size_t>(i);
-    return inertiaFactorValid_[k] ? &inertiaFactors_[k] : nullptr;
+    return links_->inertiaFactorValid[k] ? &links_->inertiaFactors[k] : nullptr;
   }
 
   /// A good resting configuration (the model's home or ready pose) [rad]. Real-time safe: yes.
@@ -249,17 +249,26 @@ class ManipulatorModel {
   void setHomePosition(const JointVector& q);
 
  private:
+  // What a model's algorithms read of its links every cycle, made once per distinct set of links:
+  // models with the same links (every Puma560Model, wherever its base) share one, so many arms
+  // of one kind keep a single copy in the caches instead of one per arm (see internLinks()).
+  struct Links {
+    std::vector<LinkParameters> links;
+    std::vector<Transform> placements;
+    std::vector<PlacementAxes> placementAxes;
+    JointVector qmin, qmax, vmax, amax, jmax, taumax, armature, cosAlpha, sinAlpha;
+    std::vector<Eigen::Matrix3d> inertiaFactors;  // Cholesky factors (getInertiaFactor())
+    std::vector<bool> inertiaFactorValid;
+  };
+  static std::shared_ptr<const Links> internLinks(std::shared_ptr<Links> links, DHConvention convention);
+
   std::string name_;
-  std::vector<LinkParameters> links_;
+  std::shared_ptr<const Links> links_;  // never null
   Transform base_, tool_;
   bool toolIsIdentity_ = false;
   Vector<3> gravity_;
   DHConvention convention_;
-  std::vector<Transform> placements_;
-  std::vector<PlacementAxes> placementAxes_;
-  JointVector qmin_, qmax_, vmax_, amax_, jmax_, taumax_, armature_, home_, cosAlpha_, sinAlpha_;
-  std::vector<Eigen::Matrix3d> inertiaFactors_;  // Cholesky factors (getInertiaFactor())
-  std::vector<bool> inertiaFactorValid_;
+  JointVector home_;
   std::shared_ptr<const ManipulatorModel> chain_;  // with mimic joints only
   std::vector<JointCoupling> coupling_;
   std::vector<int> chainIndex_;
