@@ -52,6 +52,7 @@ void SimulatedClock::pause() {
 void SimulatedClock::resume() {
   std::lock_guard<std::mutex> lock(mutex_);
   paused_ = false;
+  cv_.notify_all();  // executors held at their first tick (see waitForTick())
   advanceIfAllWaiting();
 }
 
@@ -67,9 +68,13 @@ int SimulatedClock::getNumberOfPrograms() const {
   return n;
 }
 
+// A participant's nextTick is kNotRunYet until it has run a tick (only waitForTick() reads it).
+constexpr std::uint64_t kNotRunYet = std::numeric_limits<std::uint64_t>::max();
+
 void SimulatedClock::attach(Participant& p) {
   std::lock_guard<std::mutex> lock(mutex_);
   p.waiting = false;
+  p.nextTick = kNotRunYet;
   participants_.push_back(&p);
 }
 
@@ -93,14 +98,21 @@ void SimulatedClock::advanceIfAllWaiting() {
   cv_.notify_all();
 }
 
+// An executor's first tick waits for resume() on a paused clock, even when it has come: programs
+// started on a paused clock begin together, at the first tick after resume(). Later ticks that
+// have come still run when the clock is paused in between (pause() stops time, not a tick that
+// some executors have run and others not yet).
 bool SimulatedClock::waitForTick(Participant& p, std::uint64_t tick, const std::atomic<bool>& stopFlag) {
   std::unique_lock<std::mutex> lock(mutex_);
+  const bool first = p.nextTick == kNotRunYet;
   p.nextTick = tick;
   p.waiting = true;
   advanceIfAllWaiting();
-  cv_.wait(lock, [&] { return tick_.load() >= tick || stopFlag.load(); });
+  cv_.wait(lock, [&] { return (tick_.load() >= tick && !(first && paused_)) || stopFlag.load(); });
   p.waiting = false;
-  return !stopFlag.load();
+  const bool run = !stopFlag.load();
+  if (first && !run) p.nextTick = kNotRunYet;  // woken without running: still its first tick
+  return run;
 }
 
 void SimulatedClock::interrupt() {

@@ -49,7 +49,8 @@ class SimulatedClock : public Clock {
  public:
   /// Creates a clock at time 0.
   /// @param[in] step  resolution [s]; every program period is rounded to a multiple of it
-  /// @param[in] startPaused  if true, time does not advance until resume()
+  /// @param[in] startPaused  if true, time does not advance until resume(), and programs started
+  ///                         meanwhile run their first cycle together after resume()
   explicit SimulatedClock(double step = 1e-4, bool startPaused = false);
   ~SimulatedClock() override;
   bool isSimulated() const noexcept override { return true; }
@@ -62,7 +63,9 @@ class SimulatedClock : public Clock {
   /// Time of tick `tick` [s] (tick / steps-per-second when that is a whole number).
   /// @param[in] tick  a tick number
   double tickTime(std::uint64_t tick) const noexcept;
-  /// Stops time from advancing (programs wait at their next cycle).
+  /// Stops time from advancing (programs wait at their next cycle). A program started while the
+  /// clock is paused runs its first cycle after resume(), even at the current tick, so programs
+  /// started together on a paused clock begin in the same cycle.
   void pause();
   /// Lets time advance again.
   void resume();
