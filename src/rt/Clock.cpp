@@ -28,7 +28,8 @@ double RealClock::getTime() const noexcept {
   return static_cast<double>(internal::monotonicNanoseconds() - epoch_) * 1e-9;
 }
 
-SimulatedClock::SimulatedClock(double step, bool startPaused) : step_(step > 0 ? step : 1e-4), paused_(startPaused) {}
+SimulatedClock::SimulatedClock(double step, bool startPaused)
+    : step_(step > 0 ? step : 1e-4), paused_(startPaused), neverResumed_(startPaused) {}
 
 SimulatedClock::~SimulatedClock() = default;
 
@@ -52,7 +53,10 @@ void SimulatedClock::pause() {
 void SimulatedClock::resume() {
   std::lock_guard<std::mutex> lock(mutex_);
   paused_ = false;
-  cv_.notify_all();  // executors held at their first tick (see waitForTick())
+  if (neverResumed_) {  // the programs held at tick 0 begin
+    neverResumed_ = false;
+    cv_.notify_all();
+  }
   advanceIfAllWaiting();
 }
 
@@ -68,13 +72,9 @@ int SimulatedClock::getNumberOfPrograms() const {
   return n;
 }
 
-// A participant's nextTick is kNotRunYet until it has run a tick (only waitForTick() reads it).
-constexpr std::uint64_t kNotRunYet = std::numeric_limits<std::uint64_t>::max();
-
 void SimulatedClock::attach(Participant& p) {
   std::lock_guard<std::mutex> lock(mutex_);
   p.waiting = false;
-  p.nextTick = kNotRunYet;
   participants_.push_back(&p);
 }
 
@@ -98,21 +98,17 @@ void SimulatedClock::advanceIfAllWaiting() {
   cv_.notify_all();
 }
 
-// An executor's first tick waits for resume() on a paused clock, even when it has come: programs
-// started on a paused clock begin together, at the first tick after resume(). Later ticks that
-// have come still run when the clock is paused in between (pause() stops time, not a tick that
-// some executors have run and others not yet).
+// A tick that has come runs, paused or not (pause() stops time, not a tick that some executors
+// have run and others not yet), except on a clock made paused and not resumed yet: there the
+// programs started one after another all wait, and begin together in tick 0's cycle.
 bool SimulatedClock::waitForTick(Participant& p, std::uint64_t tick, const std::atomic<bool>& stopFlag) {
   std::unique_lock<std::mutex> lock(mutex_);
-  const bool first = p.nextTick == kNotRunYet;
   p.nextTick = tick;
   p.waiting = true;
   advanceIfAllWaiting();
-  cv_.wait(lock, [&] { return (tick_.load() >= tick && !(first && paused_)) || stopFlag.load(); });
+  cv_.wait(lock, [&] { return (tick_.load() >= tick && !neverResumed_) || stopFlag.load(); });
   p.waiting = false;
-  const bool run = !stopFlag.load();
-  if (first && !run) p.nextTick = kNotRunYet;  // woken without running: still its first tick
-  return run;
+  return !stopFlag.load();
 }
 
 void SimulatedClock::interrupt() {

@@ -752,8 +752,8 @@ struct ControlProgram::Executor {
   // still to step and sets `done` to the time the phases ended [ns].
   //
   // catchUp (simulated clock): a cycle of only the programs that joined after the executor had
-  // run their first tick `tick` (a program started at tick 0 on a paused clock just after the
-  // first one): they run that tick as they would have in a thread of their own.
+  // run their first tick `tick` (a program started on a clock that has just run that tick, or
+  // that was paused after it): they run that tick as they would have in a thread of their own.
   std::size_t step(double t, std::uint64_t tick, std::int64_t woke, std::int64_t latencyNs, std::int64_t deadline,
                    std::int64_t period, bool catchUp = false) noexcept {
     const bool simulated = latencyNs < 0;

@@ -173,8 +173,8 @@ TEST(Executor, DefaultThreadModeAppliesToNewPrograms) {
 
 // The same-cycle guarantee: the reader, started first (stepped first in every phase), sees in its
 // control() the sensor the other program read in the same cycle. Without the phases (each
-// program's read, control and write in turn) it would see the previous cycle's. (Tick 0 may run
-// before the sensor has joined: compared from cycle 1 on.)
+// program's read, control and write in turn) it would see the previous cycle's. (Compared from
+// cycle 1 on, where the previous cycle's sensor reading would differ.)
 TEST(Executor, ControlSeesEveryInputOfTheSameCycleWhateverTheOrder) {
   SimulatedClock clock(1e-3, true);
   Phased reader("reader", 0, nullptr), sensor("sensor", 1, nullptr);

@@ -49,8 +49,9 @@ class SimulatedClock : public Clock {
  public:
   /// Creates a clock at time 0.
   /// @param[in] step  resolution [s]; every program period is rounded to a multiple of it
-  /// @param[in] startPaused  if true, time does not advance until resume(), and programs started
-  ///                         meanwhile run their first cycle together after resume()
+  /// @param[in] startPaused  if true, time does not advance until resume(), and no program runs
+  ///                         a cycle before it, not even at tick 0: the programs started
+  ///                         meanwhile begin together, in tick 0's cycle after resume()
   explicit SimulatedClock(double step = 1e-4, bool startPaused = false);
   ~SimulatedClock() override;
   bool isSimulated() const noexcept override { return true; }
@@ -63,9 +64,7 @@ class SimulatedClock : public Clock {
   /// Time of tick `tick` [s] (tick / steps-per-second when that is a whole number).
   /// @param[in] tick  a tick number
   double tickTime(std::uint64_t tick) const noexcept;
-  /// Stops time from advancing (programs wait at their next cycle). A program started while the
-  /// clock is paused runs its first cycle after resume(), even at the current tick, so programs
-  /// started together on a paused clock begin in the same cycle.
+  /// Stops time from advancing (programs wait at their next cycle).
   void pause();
   /// Lets time advance again.
   void resume();
@@ -96,6 +95,7 @@ class SimulatedClock : public Clock {
   std::vector<Participant*> participants_;
   std::atomic<std::uint64_t> tick_{0};
   bool paused_ = false;
+  bool neverResumed_ = false;  // made paused and not resumed yet: not even the current tick runs
 };
 
 }  // namespace rp
