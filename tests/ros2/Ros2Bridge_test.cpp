@@ -524,12 +524,17 @@ TEST_F(Ros2BridgeTest, AtTheServoRateEachSampleIsTheNextServoCycleStampedWithIts
   Puma560 puma("puma");
   CycleRecorder recorder(puma);
   recorder.start();
+  // The recorder sees a cycle's state in the next cycle: let it run before the bridge's first
+  // sample, and after its last, so that it has recorded every cycle the bridge published (ci-3,
+  // release: 399 cycles recorded for 400 samples, without these waits).
+  ASSERT_TRUE(puma.waitForCycles(3));
   options_.rate = Ros2BridgeOptions::kServoRate;
   Ros2Bridge bridge("ros", options_);
   const dds_entity_t r = reader(sensor_msgs_msg_dds__JointState__desc, "joint_states");
   std::vector<std::int64_t> stamps;  // [ns]
   takeStamps(r, stamps, 400);
   ASSERT_GE(stamps.size(), 400u);
+  ASSERT_TRUE(puma.waitForCycles(3));
   recorder.stop();
   // The offset from the arm's clock to the wall clock, as the bridge measures it (to microseconds):
   // a simulated arm's read times are its cycles' times, exactly a period apart, so offsets a whole
