@@ -656,8 +656,6 @@ void Ros2Bridge::Impl::cycle() {
     // One consistent cycle of the servo loop (DefaultManipulator's snapshot: q, qd, tau, power).
     StateSnapshot snap;
     internal::ArmCycleState cycle;
-    JointVector q(n), qd(n), tau(n);
-    bool power = m->isArmPowerOn();
     builtin_interfaces_msg_dds__Time_ stamp = publishedAt;
     bool fresh = true;  // a sample to write (at the servo rate: only of a servo cycle not yet written)
     if (m->getStateSnapshot(snap) && internal::armCycleState(*m, snap, n, cycle)) {
@@ -666,18 +664,17 @@ void Ros2Bridge::Impl::cycle() {
       const double held = snap.readTime > 0 ? snap.readTime : snap.time;
       fresh = !servo || held != e.lastTime;
       e.lastTime = held;
-      q = cycle.q;
-      qd = cycle.qd;
-      tau = cycle.tau;
-      power = cycle.power;
       // Stamped with the time the cycle read the joints, as ros2_control's joint_state_broadcaster
       // stamps with the time of the controller manager's read.
-      stamp = cycleStamp(*m, e.wall, snap.readTime > 0 ? snap.readTime : snap.time, publishedAt);
+      stamp = cycleStamp(*m, e.wall, held, publishedAt);
     } else {
-      q = m->getJointPosition();
-      qd = m->getJointVelocity();
-      tau = m->getControlOutput();
+      cycle.q = m->getJointPosition();
+      cycle.qd = m->getJointVelocity();
+      cycle.tau = m->getControlOutput();
+      cycle.power = m->isArmPowerOn();
     }
+    const JointVector &q = cycle.q, &qd = cycle.qd, &tau = cycle.tau;
+    const bool power = cycle.power;
     if (q.size() != n || qd.size() != n || tau.size() != n) continue;
     if (fresh) writeSample(model, e, q, qd, tau, stamp);
     if (!full) continue;
