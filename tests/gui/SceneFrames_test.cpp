@@ -17,10 +17,14 @@
 namespace {
 
 // A Puma whose getJointPosition() answers a later cycle's position than its published state
-// (0.05 rad further on every joint), as when its servo loop runs a cycle between two reads.
+// (0.05 rad further on every joint), as when its servo loop runs a cycle between two reads. As a
+// class derived from an arm must (docs/core.md), it starts the servo loop when it is complete and
+// stops it first: the loop calls the object's virtual functions (ThreadSanitizer saw the loop's
+// first cycle race with this constructor when Puma560's own constructor started it).
 class PumaAhead : public rp::Puma560 {
  public:
-  explicit PumaAhead(const std::string& name) : rp::Puma560(name) {}
+  explicit PumaAhead(const std::string& name) : rp::Puma560(name, DerivedClass{}) { startControlLoop(); }
+  ~PumaAhead() override { stopControlLoop(); }
   rp::JointVector getJointPosition() const override {
     rp::JointVector q = rp::Puma560::getJointPosition();
     for (int i = 0; i < q.size(); ++i) q(i) += 0.05;
