@@ -14,6 +14,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "../gui/UrlToken.hpp"
 #include "Registry.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/rt/Clock.hpp"
@@ -290,16 +291,6 @@ int RoboticPlatform::getGuiPort() {
   std::lock_guard<std::mutex> lock(state().mutex);
   return state().guiPort;
 }
-
-namespace internal {
-// Whether `token` can be a Scene Viewer token: pages present it in the URL as it is (the viewer
-// does not percent-decode), so at most 256 of the URL's unreserved characters ('a&b c' locked
-// every page out). SceneViewer::start() checks its options with it too.
-bool isUrlToken(const std::string& token) {
-  return token.size() <= 256 &&
-         token.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-._~") == std::string::npos;
-}
-}  // namespace internal
 
 void RoboticPlatform::setGuiToken(const std::string& token) {
   if (!internal::isUrlToken(token))

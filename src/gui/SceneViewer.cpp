@@ -34,6 +34,7 @@
 #include "OpenInBrowser.hpp"
 #include "QMotorRequests.hpp"
 #include "SceneState.hpp"
+#include "UrlToken.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/PhysicalObject.hpp"
 #include "rp/core/RoboticPlatform.hpp"
@@ -41,10 +42,6 @@
 #include "rp/rt/LogWriter.hpp"
 
 namespace rp {
-
-namespace internal {
-bool isUrlToken(const std::string& token);  // RoboticPlatform.cpp: the characters a token may have
-}  // namespace internal
 
 namespace {
 
