@@ -31,6 +31,7 @@
 #include <set>
 #include <thread>
 
+#include "../core/ShortNumber.hpp"
 #include "OpenInBrowser.hpp"
 #include "QMotorRequests.hpp"
 #include "SceneState.hpp"
@@ -1025,10 +1026,10 @@ void SceneViewer::start(const SceneViewerOptions& options) {
     if (m.running) throw std::logic_error("SceneViewer::start: already running");
   }
   if (!(options.rate >= 1 && options.rate <= 240))
-    throw std::invalid_argument("SceneViewer: rate must be 1..240 Hz, not " + std::to_string(options.rate));
+    throw std::invalid_argument("SceneViewer: rate must be 1..240 Hz, not " + internal::shortNumber(options.rate));
   if (!(options.writeTimeout >= 0.1 && options.writeTimeout <= 3600))
     throw std::invalid_argument("SceneViewer: writeTimeout must be 0.1..3600 s, not " +
-                                std::to_string(options.writeTimeout));
+                                internal::shortNumber(options.writeTimeout));
   if (options.port < 0 || options.port > 65535)
     throw std::invalid_argument("SceneViewer: port must be 0..65535, not " + std::to_string(options.port));
   beast::error_code ec;

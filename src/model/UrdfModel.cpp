@@ -28,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include "../core/ShortNumber.hpp"
 #include "rp/model/Kinematics.hpp"
 
 namespace rp {
@@ -106,12 +107,8 @@ Eigen::Matrix3d axisRotation(const V3& z) {
   return R;
 }
 
-// "%g" of a number.
-std::string shortNumber(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", x);
-  return buf;
-}
+// "%g" of a number (six significant digits, as a URDF file usually gives them).
+std::string shortNumber(double x) { return internal::shortNumber(x, 6); }
 
 // At most this much of a name is quoted in a message.
 std::string excerpt(const std::string& text) {

@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../core/ShortNumber.hpp"
 #include "../manipulator/ArmSnapshot.hpp"
 #include "../model/ExportFrames.hpp"
 #include "../rt/CycleSignal.hpp"
@@ -795,11 +796,8 @@ void Ros2Bridge::Impl::connectEffortControl(Manipulator& m, ArmEntry& e) {
 
 namespace {
 
-std::string number(double x) {
-  std::ostringstream o;
-  o << x;
-  return o.str();
-}
+// Six significant digits (as a stream prints them).
+std::string number(double x) { return internal::shortNumber(x, 6); }
 
 std::string field(std::size_t point, const char* name) { return "points[" + std::to_string(point) + "]." + name; }
 

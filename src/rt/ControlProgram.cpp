@@ -23,6 +23,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "../core/ShortNumber.hpp"
 #include "CycleSignal.hpp"
 #include "LogChannel.hpp"
 #include "rp/core/Configuration.hpp"
@@ -49,14 +50,6 @@ void ensureShutdownWatcher();
 namespace {
 
 constexpr double kMinRate = 1;  // Hz: the lowest rate setRate() accepts
-
-// A number in a message, as short as its value allows ("11", "1e+300"; std::to_string printed
-// 1e300 with 300 digits and 0.1 as 0.100000).
-std::string shortNumber(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.10g", v);
-  return text;
-}
 
 constexpr std::size_t kBins = 10000;  // 1 µs histogram bins; the last one holds everything above
 

@@ -11,6 +11,8 @@
 #include <array>
 #include <cmath>
 
+#include "../core/ShortNumber.hpp"
+
 namespace rp {
 
 template <int N>
@@ -44,8 +46,8 @@ JointVector DefaultTrajectoryGenerator<N>::solvePose(const Transform& pose) {
     }
     if (puma->inverseKinematicsClosest(pose, seed, q) == IkStatus::Solved) return q;
     const Vector<3> p = getPosition(pose);
-    throw std::invalid_argument(getName() + ": '" + m.getName() + "' cannot reach the pose at (" + std::to_string(p(0)) +
-                                ", " + std::to_string(p(1)) + ", " + std::to_string(p(2)) +
+    throw std::invalid_argument(getName() + ": '" + m.getName() + "' cannot reach the pose at (" + internal::shortNumber(p(0)) +
+                                ", " + internal::shortNumber(p(1)) + ", " + internal::shortNumber(p(2)) +
                                 ") m with any of its eight configurations within the joint limits");
   }
   IkOptions options;
@@ -54,7 +56,7 @@ JointVector DefaultTrajectoryGenerator<N>::solvePose(const Transform& pose) {
   if (inverseKinematics(model, data, pose, seed, q, options) != IkStatus::Solved) {
     const Vector<3> p = getPosition(pose);
     throw std::invalid_argument(getName() + ": '" + m.getName() + "' cannot reach the pose at (" +
-                                std::to_string(p(0)) + ", " + std::to_string(p(1)) + ", " + std::to_string(p(2)) +
+                                internal::shortNumber(p(0)) + ", " + internal::shortNumber(p(1)) + ", " + internal::shortNumber(p(2)) +
                                 ") m within its joint limits");
   }
   return q;

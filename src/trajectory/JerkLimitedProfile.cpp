@@ -6,12 +6,14 @@
 #include <stdexcept>
 #include <string>
 
+#include "../core/ShortNumber.hpp"
+
 namespace rp {
 
 JerkLimitedProfile::JerkLimitedProfile(double distance, double vmax, double amax, double jmax)
     : distance_(distance), jerk_(jmax) {
   if (!(distance >= 0) || !std::isfinite(distance)) {
-    throw std::invalid_argument("JerkLimitedProfile: distance must be finite and >= 0, got " + std::to_string(distance));
+    throw std::invalid_argument("JerkLimitedProfile: distance must be finite and >= 0, got " + internal::shortNumber(distance));
   }
   if (!(vmax > 0) || !(amax > 0) || !(jmax > 0)) {
     throw std::invalid_argument("JerkLimitedProfile: velocity, acceleration and jerk limits must be positive");
@@ -53,8 +55,8 @@ JerkLimitedProfile JerkLimitedProfile::withDuration(double distance, double dura
   if (distance == 0) return p;
   const double shortest = p.getDuration();
   if (!(duration >= shortest * (1 - 1e-9)) || !std::isfinite(duration)) {
-    throw std::invalid_argument("JerkLimitedProfile: a duration of " + std::to_string(duration) +
-                                " s is shorter than the minimum " + std::to_string(shortest) + " s");
+    throw std::invalid_argument("JerkLimitedProfile: a duration of " + internal::shortNumber(duration) +
+                                " s is shorter than the minimum " + internal::shortNumber(shortest) + " s");
   }
   if (duration <= shortest) return p;
   // The minimum-time profile slowed down by s = duration / shortest: the limits v / s, a / s^2,

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "../core/ShortNumber.hpp"
 #include "Blend.hpp"
 #include "CartesianPath.hpp"
 #include "rp/core/ObjectManager.hpp"
@@ -222,7 +223,7 @@ void QueueTrajectoryGenerator::pushPlanned(internal::SegmentPlan&& plan) {
 
 void QueueTrajectoryGenerator::setSpeedFraction(double fraction) {
   if (!(fraction > 0 && fraction <= 1)) {
-    throw std::invalid_argument(getName() + ": the speed fraction must lie in (0, 1], got " + std::to_string(fraction));
+    throw std::invalid_argument(getName() + ": the speed fraction must lie in (0, 1], got " + internal::shortNumber(fraction));
   }
   std::lock_guard<std::mutex> lock(producerMutex_);
   speedFraction_ = fraction;

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "../core/ShortNumber.hpp"
 #include "Segment.hpp"
 
 namespace rp {
@@ -58,8 +59,8 @@ TimedJointTrajectory::TimedJointTrajectory(std::vector<TimedJointPoint> points) 
     if (!p.acceleration.allFinite()) throw std::invalid_argument(at(k, "accelerations: a value that is not finite"));
     if (!std::isfinite(p.time) || p.time < 0) throw std::invalid_argument(at(k, "time: negative or not finite"));
     if (!(p.time > previous))
-      throw std::invalid_argument(at(k, "time: ") + std::to_string(p.time) + " s, not after the point before (" +
-                                  std::to_string(previous) + " s)");
+      throw std::invalid_argument(at(k, "time: ") + internal::shortNumber(p.time) + " s, not after the point before (" +
+                                  internal::shortNumber(previous) + " s)");
     previous = p.time;
   }
   const TimedJointPoint& last = points_.back();

@@ -209,6 +209,10 @@ TEST(TimedJointTrajectory, BadPointsAreRefusedNamingThePointAndField) {
   EXPECT_TRUE(contains(refusal([&] { TimedJointTrajectory t({point(1, q), point(1, q)}); }), "point 1 time"));
   EXPECT_TRUE(contains(refusal([&] { TimedJointTrajectory t({point(2, q), point(1, q)}); }), "point 1 time"));
   EXPECT_TRUE(contains(refusal([&] { TimedJointTrajectory t({point(-1, q)}); }), "point 0 time"));
+  // The times as the user gave them, however small (std::to_string said "0.000000 s, not after
+  // the point before (0.000000 s)" for 1 us and 2 us).
+  EXPECT_TRUE(contains(refusal([&] { TimedJointTrajectory t({point(2e-6, q), point(1e-6, q)}); }),
+                       "point 1 time: 1e-06 s, not after the point before (2e-06 s)"));
   EXPECT_TRUE(contains(refusal([&] { TimedJointTrajectory t({point(1, q), point(2, vec({0, NAN}))}); }), "point 1 positions"));
   EXPECT_TRUE(contains(refusal([&] { TimedJointTrajectory t({point(1, q), point(2, vec({0}))}); }), "point 1 positions"));
   EXPECT_TRUE(contains(refusal([&] { TimedJointTrajectory t({point(1, q, q), point(2, q)}); }), "point 1 velocities"));
