@@ -172,7 +172,10 @@ struct Ros2IoBoard::Impl {
           stampToLocal += std::clamp(lowestSeen - stampToLocal, -slew, slew);
         }
         lastStamp = stamp;
-        if (firstStamp.load(std::memory_order_relaxed) == 0) firstStamp.store(stamp);
+        // The rate is measured from the second sample on: the first may be old (a sample the
+        // remote published before this board joined, delivered late), and its gap to the next
+        // is no remote cycle.
+        if (samples.load(std::memory_order_relaxed) == 1) firstStamp.store(stamp);
         latestStamp.store(stamp);
         // A sequence lock without fences (ThreadSanitizer has none): the counts are stored with
         // release after the -1, and read with acquire before the second look at sampleTime.
@@ -301,7 +304,7 @@ Ros2IoBoard::Ros2IoBoard(const Ros2IoBoardOptions& options, const std::vector<st
   while (d.samples.load() < kRateSamples && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   const std::uint64_t counted = d.samples.load();
-  const double interval = counted >= 2 ? 1e-9 * static_cast<double>(d.latestStamp.load() - d.firstStamp.load()) / static_cast<double>(counted - 1)
+  const double interval = counted >= 3 ? 1e-9 * static_cast<double>(d.latestStamp.load() - d.firstStamp.load()) / static_cast<double>(counted - 2)
                                        : std::numeric_limits<double>::infinity();
   if (interval > kLongestSampleInterval) {
     char text[200];
