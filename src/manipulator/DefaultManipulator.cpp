@@ -1184,21 +1184,23 @@ void DefaultManipulator::powerOffNow() noexcept {
 }
 
 void DefaultManipulator::publish() {
-  PublishedState s;
-  s.time = getTime();
-  s.readTime = readTime_;
-  s.cycle = getCycleCount();
-  s.n = static_cast<int>(q_.size());
-  s.power = power_;
-  s.missed = missedCycles_;
-  s.saturated = static_cast<double>(saturatedCycles_.load(std::memory_order_relaxed));
-  for (int i = 0; i < s.n; ++i) {
-    s.q[i] = q_(i);
-    s.qd[i] = qd_(i);
-    s.tau[i] = tau_(i);
-    s.qdes[i] = setpoint_.position(i);
-  }
-  published_.write(s);
+  // In place: the arm's n joints of the arrays sized for kMaxJoints (the others stay 0), every
+  // other field set.
+  published_.update([&](PublishedState& s) noexcept {
+    s.time = getTime();
+    s.readTime = readTime_;
+    s.cycle = getCycleCount();
+    s.n = static_cast<int>(q_.size());
+    s.power = power_;
+    s.missed = missedCycles_;
+    s.saturated = static_cast<double>(saturatedCycles_.load(std::memory_order_relaxed));
+    for (int i = 0; i < s.n; ++i) {
+      s.q[i] = q_(i);
+      s.qd[i] = qd_(i);
+      s.tau[i] = tau_(i);
+      s.qdes[i] = setpoint_.position(i);
+    }
+  });
 }
 
 Model3D DefaultManipulator::get3DModel() const {

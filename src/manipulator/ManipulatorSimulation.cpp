@@ -7,8 +7,10 @@
 #include <cstdio>
 #include <cstdint>
 #include <mutex>
+#include <new>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -207,6 +209,32 @@ bool solveContactMode(const JointMatrix& A, const JointVector& rhs, const JointV
   return true;
 }
 
+// A step's scratch: the integrators', the friction problem's and the payload's vectors and
+// matrices, written and read within one step() (none carries anything to the next). One per
+// thread: with many arms in one executor an arm's own memory is cold by its next step, and scratch
+// kept there cost every step a cache line fetched and one written back for each vector; this
+// thread's stays in its caches from one arm to the next. Raw storage and the object made in it on
+// first use, as ThreadWorkspace.cpp does (trivially destructible: the thread-local needs no exit
+// handler, whose registration allocates; the object owns no heap memory).
+struct StepScratch {
+  JointVector tauTotal, diag, rhs, residual, upper, lower, q0, v0, kq, kv, sumQ, sumV, payloadBias;
+  JointMatrix A, L, payloadMass;
+  std::uint64_t startMode = 0;  // the contact mode of the velocities the Euler step starts from
+};
+struct StepScratchSlot {
+  alignas(StepScratch) unsigned char bytes[sizeof(StepScratch)];
+  StepScratch* scratch = nullptr;
+};
+static_assert(std::is_trivially_destructible_v<StepScratchSlot>);
+thread_local StepScratchSlot tStepScratch;
+
+// This thread's step scratch. Real-time safe: yes (no allocation).
+StepScratch& stepScratch() noexcept {
+  StepScratchSlot& slot = tStepScratch;
+  if (slot.scratch == nullptr) slot.scratch = new (slot.bytes) StepScratch();
+  return *slot.scratch;
+}
+
 }  // namespace
 
 // The unit payload models by centre, kept for the simulation's life (the stepping thread may use
@@ -235,13 +263,7 @@ ManipulatorSimulation::~ManipulatorSimulation() = default;
 void ManipulatorSimulation::init() {
   const int n = model_.getNumberOfJoints();
   q_ = model_.getHomePosition();
-  for (JointVector* v : {&qd_, &qdd_, &tauTotal_, &tauExt_, &tauApplied_, &coulombPos_, &coulombNeg_, &viscous_, &diag_,
-                         &rhs_, &residual_, &upper_, &lower_, &q0_, &v0_, &kq_, &kv_, &sumQ_, &sumV_})
-    v->setZero(n);
-  A_.setZero(n, n);
-  L_.setZero(n, n);
-  payloadMass_.setZero(n, n);
-  payloadBias_.setZero(n);
+  for (JointVector* v : {&qd_, &qdd_, &tauExt_, &tauApplied_, &coulombPos_, &coulombNeg_, &viscous_}) v->setZero(n);
   zero_.setZero(n);
   payload_ = std::make_unique<Payload>();
   brakeTorque_ = model_.getTorqueLimit();
@@ -301,12 +323,14 @@ void ManipulatorSimulation::dynamics(const JointVector& tau) {
   // (M + m M_u) qdd = tau - h - m h_u: the arm's forward dynamics under tau - m h_u gives M and
   // M qdd' = tau - h - m h_u, which is the right-hand side.
   Payload::Unit& u = payload_->units[static_cast<std::size_t>(stepCentre_)];
-  payloadBias_ = tau - stepMass_ * inverseDynamics(*u.model, *u.data, q_, qd_, zero_);
-  forwardDynamics(model_, d, q_, qd_, payloadBias_, options_);
-  payloadBias_.noalias() = d.massMatrix * d.qdd;
-  payloadMass_ = d.massMatrix + stepMass_ * massMatrix(*u.model, *u.data, q_);
-  choleskySolve(payloadMass_, payloadBias_, L_, d.qdd);
-  d.massMatrix = payloadMass_;
+  StepScratch& s = stepScratch();
+  s.payloadBias = tau - stepMass_ * inverseDynamics(*u.model, *u.data, q_, qd_, zero_);
+  forwardDynamics(model_, d, q_, qd_, s.payloadBias, options_);
+  s.payloadBias.noalias() = d.massMatrix * d.qdd;
+  s.payloadMass = d.massMatrix + stepMass_ * massMatrix(*u.model, *u.data, q_);
+  s.L.resize(s.payloadMass.rows(), s.payloadMass.cols());
+  choleskySolve(s.payloadMass, s.payloadBias, s.L, d.qdd);
+  d.massMatrix = s.payloadMass;
 }
 
 const JointMatrix& ManipulatorSimulation::plantMassMatrix() {
@@ -462,45 +486,51 @@ void ManipulatorSimulation::eulerStep(double h) {
   // (M + h diag(b + c + h k)) v+ = M (v + h qdd0) with qdd0 = M^-1 (tau - bias - k (q - limit)).
   const int n = model_.getNumberOfJoints();
   const double k = stopStiffness_;
+  StepScratch& sc = stepScratch();
   // A stop acts on the penetration at the end of the step, so it engages in the step in which the
   // joint would cross its limit (q + h v beyond it): a joint never enters a stop by a whole step's
   // travel unopposed (that would store spring energy it never had).
-  tauTotal_ = tauApplied_ - viscous_.cwiseProduct(qd_);
+  sc.tauTotal = tauApplied_ - viscous_.cwiseProduct(qd_);
   for (int i = 0; i < n; ++i) {
     const double lo = model_.getPositionMin()(i), hi = model_.getPositionMax()(i), next = q_(i) + h * qd_(i);
     engaged_[static_cast<std::size_t>(i)] = q_(i) < lo || q_(i) > hi || next < lo || next > hi;
     if (!engaged_[static_cast<std::size_t>(i)]) continue;
-    tauTotal_(i) += k * ((q_(i) > hi || next > hi ? hi : lo) - q_(i));
+    sc.tauTotal(i) += k * ((q_(i) > hi || next > hi ? hi : lo) - q_(i));
   }
-  dynamics(tauTotal_);
+  dynamics(sc.tauTotal);
   const ManipulatorData& d = internal::workspaceOr(model_, data_);
   const JointMatrix& M = d.massMatrix;
+  sc.diag.resize(n);
   for (int i = 0; i < n; ++i) {
-    diag_(i) = viscous_(i);
+    sc.diag(i) = viscous_(i);
     // A stop critically damped for the joint's inertia at the stop.
-    if (engaged_[static_cast<std::size_t>(i)]) diag_(i) += 2.0 * std::sqrt(k * M(i, i)) + h * k;
+    if (engaged_[static_cast<std::size_t>(i)]) sc.diag(i) += 2.0 * std::sqrt(k * M(i, i)) + h * k;
   }
   // qdd0 with the viscous torque at the start of the step (what getAcceleration() reports), so
   // the right-hand side adds it back: M (v + h qdd0) + h b v.
   qdd_ = d.qdd;
-  v0_ = qd_ + h * qdd_;
-  rhs_.noalias() = M * v0_;
-  rhs_ += h * viscous_.cwiseProduct(qd_);
-  A_ = M;
-  for (int i = 0; i < n; ++i) A_(i, i) += h * diag_(i);
+  sc.v0 = qd_ + h * qdd_;
+  sc.rhs.noalias() = M * sc.v0;
+  sc.rhs += h * viscous_.cwiseProduct(qd_);
+  sc.A = M;
+  for (int i = 0; i < n; ++i) sc.A(i, i) += h * sc.diag(i);
   if (hasCoulomb_ || brakes_) {
     // The friction problem's solution is exact from any start (solveFriction() ends with the
     // exact solution of its contact mode): it starts from v0, whose residual A v0 - rhs =
     // h (diag v0 - b v) takes no product with A, and A itself is never factorized (only M, in
-    // the forward dynamics, and the contact mode's rows of A).
-    for (int i = 0; i < n; ++i) residual_(i) = h * (diag_(i) * v0_(i) - viscous_(i) * qd_(i));
-    qd_ = v0_;
+    // the forward dynamics, and the contact mode's rows of A). The mode of the velocities the step
+    // starts from is tried first.
+    sc.residual.resize(n);
+    for (int i = 0; i < n; ++i) sc.residual(i) = h * (sc.diag(i) * sc.v0(i) - viscous_(i) * qd_(i));
+    sc.startMode = contactMode(qd_);
+    qd_ = sc.v0;
     solveFriction(h);
-  } else if (diag_.cwiseAbs().maxCoeff() > 0) {
+  } else if (sc.diag.cwiseAbs().maxCoeff() > 0) {
     // v* = A^-1 rhs by Cholesky (A is positive definite).
-    choleskySolve(A_, rhs_, L_, qd_);
+    sc.L.resize(n, n);
+    choleskySolve(sc.A, sc.rhs, sc.L, qd_);
   } else {
-    qd_ = v0_;  // without implicit terms v* = v0 exactly
+    qd_ = sc.v0;  // without implicit terms v* = v0 exactly
   }
   q_ += h * qd_;
 }
@@ -511,80 +541,100 @@ void ManipulatorSimulation::rk4Step(double h) {
   // as in the Euler step, taken over the step (the position moves by half the velocity change, as
   // under a constant friction torque; a joint at rest that stays at rest does not move at all).
   const int n = model_.getNumberOfJoints();
-  q0_ = q_;
-  v0_ = qd_;
-  sumQ_.setZero();
-  sumV_.setZero();
+  StepScratch& sc = stepScratch();
+  sc.q0 = q_;
+  sc.v0 = qd_;
+  sc.sumQ.setZero(n);
+  sc.sumV.setZero(n);
   const ManipulatorData& d = internal::workspaceOr(model_, data_);  // where dynamics() leaves its results
   for (int s = 0; s < 4; ++s) {
-    tauTotal_ = tauApplied_ - viscous_.cwiseProduct(qd_);
-    dynamics(tauTotal_);
-    kq_ = qd_;
-    kv_ = d.qdd;
-    if (s == 0) qdd_ = kv_;
+    sc.tauTotal = tauApplied_ - viscous_.cwiseProduct(qd_);
+    dynamics(sc.tauTotal);
+    sc.kq = qd_;
+    sc.kv = d.qdd;
+    if (s == 0) qdd_ = sc.kv;
     const double w = (s == 0 || s == 3) ? 1.0 : 2.0;
-    sumQ_ += w * kq_;
-    sumV_ += w * kv_;
+    sc.sumQ += w * sc.kq;
+    sc.sumV += w * sc.kv;
     if (s < 3) {
       const double c = s < 2 ? 0.5 * h : h;
-      q_ = q0_ + c * kq_;
-      qd_ = v0_ + c * kv_;
+      q_ = sc.q0 + c * sc.kq;
+      qd_ = sc.v0 + c * sc.kv;
     }
   }
-  q_ = q0_ + (h / 6.0) * sumQ_;
-  qd_ = v0_ + (h / 6.0) * sumV_;
+  q_ = sc.q0 + (h / 6.0) * sc.sumQ;
+  qd_ = sc.v0 + (h / 6.0) * sc.sumV;
   if (hasCoulomb_ || brakes_) {
     // The mass matrix at the last stage (q0 + h v3), the end of the step to first order.
-    A_ = d.massMatrix;
-    rhs_.noalias() = A_ * qd_;
-    residual_.setZero();  // A qd - rhs
-    kv_ = qd_;
+    sc.A = d.massMatrix;
+    sc.rhs.noalias() = sc.A * qd_;
+    sc.residual.setZero(n);  // A qd - rhs
+    sc.kv = qd_;
+    sc.startMode = contactMode(sc.v0);
     solveFriction(h);
-    for (int i = 0; i < n; ++i) q_(i) = (v0_(i) == 0 && qd_(i) == 0) ? q0_(i) : q_(i) + 0.5 * h * (qd_(i) - kv_(i));
+    for (int i = 0; i < n; ++i)
+      q_(i) = (sc.v0(i) == 0 && qd_(i) == 0) ? sc.q0(i) : q_(i) + 0.5 * h * (qd_(i) - sc.kv(i));
   }
 }
 
 void ManipulatorSimulation::solveFriction(double h) {
   // Minimise 1/2 v^T A v - rhs^T v + h sum_i f_i(v_i), f_i(v) = F+ v (v > 0), -F- v (v < 0), by
-  // exact coordinate descent from the start in qd_ (its residual A qd_ - rhs in residual_, which
-  // the caller sets): each coordinate's minimiser is a soft threshold. The objective is strictly
-  // convex, so the sweeps converge to its minimiser; a joint whose holding torque is within its
-  // friction comes out exactly at rest.
+  // exact coordinate descent from the start in qd_ (its residual A qd_ - rhs in the scratch's
+  // residual, which the caller sets): each coordinate's minimiser is a soft threshold. The
+  // objective is strictly convex, so the sweeps converge to its minimiser; a joint whose holding
+  // torque is within its friction comes out exactly at rest.
   const int n = model_.getNumberOfJoints();
+  StepScratch& sc = stepScratch();
+  const JointMatrix& A = sc.A;
+  sc.upper.resize(n);
+  sc.lower.resize(n);
   for (int i = 0; i < n; ++i) {
     const double brake = brakes_ ? brakeTorque_(i) : 0.0;
-    upper_(i) = h * (coulombPos_(i) + brake);
-    lower_(i) = h * (coulombNeg_(i) + brake);
+    sc.upper(i) = h * (coulombPos_(i) + brake);
+    sc.lower(i) = h * (coulombNeg_(i) + brake);
   }
-  std::uint64_t lastMode = contactMode(qd_), triedMode = ~std::uint64_t{0};
+  // The contact mode of the velocities the step started from (which joints stuck, which way the
+  // others slid) is usually the minimiser's: that mode's exact solution, if it is optimal, needs
+  // no sweep (and is the sweeps' result too: the minimiser is unique, and a mode's solution
+  // depends on the mode alone).
+  sc.kq.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const std::uint64_t bits = (sc.startMode >> (2 * i)) & 3;
+    sc.kq(i) = bits == 1 ? 1.0 : bits == 2 ? -1.0 : 0.0;
+  }
+  if (solveContactMode(A, sc.rhs, sc.upper, sc.lower, sc.kq)) {
+    qd_ = sc.kq;
+    return;
+  }
+  std::uint64_t lastMode = contactMode(qd_), triedMode = sc.startMode;
   for (int sweep = 0; sweep < kMaxFrictionSweeps; ++sweep) {
     double change = 0;
     for (int i = 0; i < n; ++i) {
-      const double a = A_(i, i);
-      const double p = a * qd_(i) - residual_(i);  // a times the coordinate's unconstrained minimiser
+      const double a = A(i, i);
+      const double p = a * qd_(i) - sc.residual(i);  // a times the coordinate's unconstrained minimiser
       double x = 0;
       if (!std::isfinite(p)) {
         x = p;  // a force that is not finite (e.g. from the environment) is no friction problem:
                 // the state becomes non-finite, which the servo loop sees and stops on
-      } else if (p > upper_(i)) {
-        x = (p - upper_(i)) / a;
-      } else if (p < -lower_(i)) {
-        x = (p + lower_(i)) / a;
+      } else if (p > sc.upper(i)) {
+        x = (p - sc.upper(i)) / a;
+      } else if (p < -sc.lower(i)) {
+        x = (p + sc.lower(i)) / a;
       }
       const double d = x - qd_(i);
       if (d == 0) continue;
       qd_(i) = x;
-      residual_ += A_.col(i) * d;
+      sc.residual += A.col(i) * d;
       change = std::max(change, std::abs(d));
     }
     if (change <= kFrictionTolerance) break;
-    // The contact mode the sweep has reached (which joints stick, which way the others slide) is
-    // usually the minimiser's after one sweep: that mode's exact solution, if it is optimal, ends
-    // the sweeps. Later, a mode is tried once a sweep leaves it unchanged, and never again after
-    // failing (its solution depends on the mode alone).
+    // The contact mode the sweep has reached is usually the minimiser's after one sweep: that
+    // mode's exact solution, if it is optimal, ends the sweeps. Later, a mode is tried once a
+    // sweep leaves it unchanged, and never again after failing (its solution depends on the mode
+    // alone).
     const std::uint64_t mode = contactMode(qd_);
     if ((sweep == 0 || mode == lastMode) && mode != triedMode) {
-      if (solveContactMode(A_, rhs_, upper_, lower_, qd_)) break;
+      if (solveContactMode(A, sc.rhs, sc.upper, sc.lower, qd_)) break;
       triedMode = mode;
     }
     lastMode = mode;

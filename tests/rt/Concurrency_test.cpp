@@ -193,6 +193,45 @@ TEST(TripleBufferThreads, ReadersSeeWholeValuesInOrder) {
   EXPECT_EQ(p.a, 50000);
 }
 
+// update() fills the buffer in place (an arm publishes its n joints of arrays sized for the most
+// joints so): readers see whole values in order, and the fields it leaves alone keep what they
+// had (the buffer it fills holds the value of three writes before, not a fresh one).
+TEST(TripleBufferThreads, ValuesUpdatedInPlaceAreWholeAndInOrder) {
+  TripleBuffer<Pair> buffer;
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    for (long i = 1; i <= 50000; ++i)
+      buffer.update([i](Pair& p) noexcept {
+        p.a = i;
+        p.b = 2 * i;
+      });
+    done = true;
+  });
+  std::atomic<bool> torn{false}, backwards{false};
+  std::thread reader([&] {
+    long last = 0;
+    Pair v;
+    while (!done) {
+      if (!buffer.read(v)) continue;
+      if (v.b != 2 * v.a) torn = true;
+      if (v.a < last) backwards = true;
+      last = v.a;
+    }
+  });
+  writer.join();
+  reader.join();
+  EXPECT_FALSE(torn);
+  EXPECT_FALSE(backwards);
+  Pair p;
+  ASSERT_TRUE(buffer.read(p));
+  EXPECT_EQ(p.a, 50000);
+  // A field update() does not set: what the buffer held. Each of the three buffers had b set.
+  for (int k = 0; k < 3; ++k) buffer.update([](Pair& q) noexcept { q.a = -1; });
+  ASSERT_TRUE(buffer.read(p));
+  EXPECT_EQ(p.a, -1);
+  EXPECT_GT(p.b, 0) << "update() handed a buffer that was not the one written before";
+}
+
 // The one reader of readAsOnlyReader() (no lock): whole values, in order, and the last one.
 TEST(TripleBufferThreads, TheOnlyReaderSeesWholeValuesInOrderWithoutALock) {
   TripleBuffer<Pair> buffer;

@@ -212,7 +212,6 @@ class ManipulatorSimulation {
 
  private:
   void init();
-  void appliedTorque(const JointVector& tau);
   void eulerStep(double h);
   void rk4Step(double h);
   void solveFriction(double h);
@@ -226,13 +225,12 @@ class ManipulatorSimulation {
 
   // What every step reads and writes comes first, and what only some steps use (a payload, link
   // wrenches, a sensor delay) last: with hundreds of arms in one servo cycle, the pages and cache
-  // lines an arm's step touches are the cost (docs/realtime.md).
+  // lines an arm's step touches are the cost (docs/realtime.md). The steps' scratch (the
+  // integrators', the friction problem's, the payload's) is not here but the stepping thread's
+  // (ManipulatorSimulation.cpp): it stays in that thread's caches from one arm to the next.
   std::unique_ptr<const ManipulatorModel> own_;  // the plant's model when it deviates (before model_)
   const ManipulatorModel& model_;
-  JointVector q_, qd_, qdd_, tauTotal_, tauExt_, tauApplied_, coulombPos_, coulombNeg_, brakeTorque_, viscous_;
-  // Scratch of the steps: implicit diagonal, right-hand side, residual, friction bounds, RK4 stages.
-  JointVector diag_, rhs_, residual_, upper_, lower_, q0_, v0_, kq_, kv_, sumQ_, sumV_;
-  JointMatrix A_, L_;
+  JointVector q_, qd_, qdd_, tauExt_, tauApplied_, coulombPos_, coulombNeg_, brakeTorque_, viscous_;
   std::array<bool, kMaxJoints> engaged_{};  // joints whose stop acts in the current Euler step
   Vector<6> wrench_;
   int linkWrenches_ = 0;  // number of links with a non-zero wrench
@@ -257,9 +255,7 @@ class ManipulatorSimulation {
 
   struct Payload;  // the unit point-mass models by centre and the hand-over
   std::unique_ptr<Payload> payload_;
-  JointVector payloadBias_;  // scratch: the arm's torques less the payload's bias
-  JointVector zero_;         // zero accelerations (the payload's bias torques)
-  JointMatrix payloadMass_;  // scratch: the mass matrix with the payload
+  JointVector zero_;  // zero accelerations (the payload's bias torques)
   std::array<Vector<3>, kMaxJoints> linkPoint_{};
   std::array<Vector<6>, kMaxJoints> linkWrench_{};
 };

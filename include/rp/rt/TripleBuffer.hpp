@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <mutex>
 #include <type_traits>
+#include <utility>
 
 namespace rp {
 
@@ -27,10 +28,21 @@ class TripleBuffer {
   /// Real-time safe: yes.
   void write(const T& value) noexcept {
     buffers_[back_] = value;
-    // Swap the back buffer with the middle one and mark it fresh.
-    unsigned old = middle_.exchange(back_ | kFresh, std::memory_order_acq_rel);
-    back_ = old & kIndex;
-    written_.store(true, std::memory_order_release);
+    publishBack();
+  }
+
+  /// Publishes a value written in place: `fill(T& value)` sets the fields of the buffer that goes
+  /// out next, which holds an older value (the one written three writes ago, or the value-initialised
+  /// one), not a fresh one, so it must set every field it means to publish. For a large value of
+  /// which the writer sets only a part (an arm's joint arrays sized for the most joints any arm
+  /// has): no copy of the whole, no cache lines written that did not change. Only one thread may
+  /// write (write() or update()).
+  /// @param[in] fill  called once with the buffer to fill
+  /// Real-time safe: yes, if `fill` is.
+  template <typename Fill>
+  void update(Fill&& fill) noexcept(noexcept(fill(std::declval<T&>()))) {
+    fill(buffers_[back_]);
+    publishBack();
   }
   /// Copies the latest value into `out`.
   /// @param[out] out  receives the value
@@ -63,6 +75,13 @@ class TripleBuffer {
 
  private:
   static constexpr unsigned kFresh = 4, kIndex = 3;
+
+  // Swaps the back buffer with the middle one and marks it fresh.
+  void publishBack() noexcept {
+    unsigned old = middle_.exchange(back_ | kFresh, std::memory_order_acq_rel);
+    back_ = old & kIndex;
+    written_.store(true, std::memory_order_release);
+  }
   mutable T buffers_[3]{};
   unsigned back_ = 0;                           // writer's
   mutable std::atomic<unsigned> middle_{1};     // shared
