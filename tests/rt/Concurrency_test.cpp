@@ -163,6 +163,19 @@ struct Pair {
   long a = 0, b = 0;  // b == 2 * a in every published value
 };
 
+// A reader of `buffer` until `done`: flags a torn value (b != 2 a) and one older than the last.
+void readUntilDone(const TripleBuffer<Pair>& buffer, const std::atomic<bool>& done, std::atomic<bool>& torn,
+                   std::atomic<bool>& backwards) {
+  long last = 0;
+  Pair v;
+  while (!done) {
+    if (!buffer.read(v)) continue;
+    if (v.b != 2 * v.a) torn = true;
+    if (v.a < last) backwards = true;
+    last = v.a;
+  }
+}
+
 TEST(TripleBufferThreads, ReadersSeeWholeValuesInOrder) {
   TripleBuffer<Pair> buffer;
   Pair p;
@@ -174,17 +187,7 @@ TEST(TripleBufferThreads, ReadersSeeWholeValuesInOrder) {
   });
   std::vector<std::thread> readers;
   std::atomic<bool> torn{false}, backwards{false};
-  for (int r = 0; r < 2; ++r)
-    readers.emplace_back([&] {
-      long last = 0;
-      Pair v;
-      while (!done) {
-        if (!buffer.read(v)) continue;
-        if (v.b != 2 * v.a) torn = true;
-        if (v.a < last) backwards = true;
-        last = v.a;
-      }
-    });
+  for (int r = 0; r < 2; ++r) readers.emplace_back([&] { readUntilDone(buffer, done, torn, backwards); });
   writer.join();
   for (auto& r : readers) r.join();
   EXPECT_FALSE(torn);
@@ -208,16 +211,7 @@ TEST(TripleBufferThreads, ValuesUpdatedInPlaceAreWholeAndInOrder) {
     done = true;
   });
   std::atomic<bool> torn{false}, backwards{false};
-  std::thread reader([&] {
-    long last = 0;
-    Pair v;
-    while (!done) {
-      if (!buffer.read(v)) continue;
-      if (v.b != 2 * v.a) torn = true;
-      if (v.a < last) backwards = true;
-      last = v.a;
-    }
-  });
+  std::thread reader([&] { readUntilDone(buffer, done, torn, backwards); });
   writer.join();
   reader.join();
   EXPECT_FALSE(torn);
