@@ -77,7 +77,9 @@ void DefaultPositionControl::calculate() {
       integral_(i) = std::clamp(integral_(i) + e * period_, -bound, bound);
     }
     const double v = sp.velocity(i);
-    const double coulomb = std::tanh(v / kSmoothing) * (v >= 0 ? coulombPos_(i) : -coulombNeg_(i));
+    // (tanh is +-1 exactly from 22 on: glibc's tanh returns that there without computing)
+    const double x = v / kSmoothing;
+    const double coulomb = (std::abs(x) >= 22 ? std::copysign(1.0, x) : std::tanh(x)) * (v >= 0 ? coulombPos_(i) : -coulombNeg_(i));
     const double t = kp_(i) * e + kd_(i) * (v - qd(i)) + ki_(i) * integral_(i) + viscous_(i) * v + coulomb;
     tau_(i) = std::clamp(t, -limit_(i), limit_(i));
   }

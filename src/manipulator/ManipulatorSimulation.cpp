@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <cstdint>
 #include <mutex>
@@ -28,7 +29,11 @@ constexpr int kMaxStopSubsteps = 100;
 
 // Whether an external wrench acts: any component not zero, a NaN included (a wrench that is not
 // a number is not "no wrench": it makes the state non-finite, which the servo loop stops on).
-bool acts(const Vector<6>& wrench) { return !(wrench.array() == 0.0).all(); }
+bool acts(const Vector<6>& wrench) {
+  for (int i = 0; i < 6; ++i)
+    if (!(wrench(i) == 0.0)) return true;
+  return false;
+}
 
 // A model that keeps another's home position (ManipulatorModel::setHomePosition is protected).
 class PlantModel : public ManipulatorModel {
@@ -155,6 +160,20 @@ void choleskySolve(const JointMatrix& A, const JointVector& b, JointMatrix& L, J
     double s = x(i);
     for (int m = i + 1; m < n; ++m) s -= L(m, i) * x(m);
     x(i) = s * inverse[static_cast<std::size_t>(i)];
+  }
+}
+
+// y = M x for a symmetric n x n M (the mass matrix, a friction problem's matrix), row by row as
+// columns (M is column-major): plain loops over n, where Eigen's product on sizes known only at run
+// time took its general matrix-vector kernel, three times the instructions for n = 6.
+void symmetricTimes(const JointMatrix& M, const JointVector& x, JointVector& y) noexcept {
+  const auto n = static_cast<int>(x.size());
+  y.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const double* column = M.data() + static_cast<std::ptrdiff_t>(i) * M.rows();  // = row i
+    double sum = 0;
+    for (int k = 0; k < n; ++k) sum += column[k] * x(k);
+    y(i) = sum;
   }
 }
 
@@ -510,7 +529,7 @@ void ManipulatorSimulation::eulerStep(double h) {
   // the right-hand side adds it back: M (v + h qdd0) + h b v.
   qdd_ = d.qdd;
   sc.v0 = qd_ + h * qdd_;
-  sc.rhs.noalias() = M * sc.v0;
+  symmetricTimes(M, sc.v0, sc.rhs);
   sc.rhs += h * viscous_.cwiseProduct(qd_);
   sc.A = M;
   for (int i = 0; i < n; ++i) sc.A(i, i) += h * sc.diag(i);
@@ -567,7 +586,7 @@ void ManipulatorSimulation::rk4Step(double h) {
   if (hasCoulomb_ || brakes_) {
     // The mass matrix at the last stage (q0 + h v3), the end of the step to first order.
     sc.A = d.massMatrix;
-    sc.rhs.noalias() = sc.A * qd_;
+    symmetricTimes(sc.A, qd_, sc.rhs);
     sc.residual.setZero(n);  // A qd - rhs
     sc.kv = qd_;
     sc.startMode = contactMode(sc.v0);
