@@ -198,7 +198,7 @@ TEST(TripleBufferThreads, ReadersSeeWholeValuesInOrder) {
 
 // update() fills the buffer in place (an arm publishes its n joints of arrays sized for the most
 // joints so): readers see whole values in order, and the fields it leaves alone keep what they
-// had (the buffer it fills holds the value of three writes before, not a fresh one).
+// had (the buffer it fills holds an older value, not a fresh one).
 TEST(TripleBufferThreads, ValuesUpdatedInPlaceAreWholeAndInOrder) {
   TripleBuffer<Pair> buffer;
   std::atomic<bool> done{false};

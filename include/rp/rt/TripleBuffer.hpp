@@ -32,7 +32,7 @@ class TripleBuffer {
   }
 
   /// Publishes a value written in place: `fill(T& value)` sets the fields of the buffer that goes
-  /// out next, which holds an older value (the one written three writes ago, or the value-initialised
+  /// out next, which holds an older value (one written before the last, or the value-initialised
   /// one), not a fresh one, so it must set every field it means to publish. For a large value of
   /// which the writer sets only a part (an arm's joint arrays sized for the most joints any arm
   /// has): no copy of the whole, no cache lines written that did not change. Only one thread may
