@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstdint>
 #include <mutex>
-#include <new>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -16,6 +15,7 @@
 #include <vector>
 
 #include "../model/ThreadWorkspace.hpp"
+#include "../rt/ThreadLocalSlot.hpp"
 #include "SeqlockHandover.hpp"
 #include "rp/core/Configuration.hpp"
 
@@ -232,27 +232,17 @@ bool solveContactMode(const JointMatrix& A, const JointVector& rhs, const JointV
 // matrices, written and read within one step() (none carries anything to the next). One per
 // thread: with many arms in one executor an arm's own memory is cold by its next step, and scratch
 // kept there cost every step a cache line fetched and one written back for each vector; this
-// thread's stays in its caches from one arm to the next. Raw storage and the object made in it on
-// first use, as ThreadWorkspace.cpp does (trivially destructible: the thread-local needs no exit
-// handler, whose registration allocates; the object owns no heap memory).
+// thread's stays in its caches from one arm to the next. It owns no heap memory.
 struct StepScratch {
   JointVector tauTotal, diag, rhs, residual, upper, lower, q0, v0, kq, kv, sumQ, sumV, payloadBias;
+  JointVector start;  // the velocities the step starts from: their contact mode is tried first
   JointMatrix A, L, payloadMass;
-  std::uint64_t startMode = 0;  // the contact mode of the velocities the Euler step starts from
 };
-struct StepScratchSlot {
-  alignas(StepScratch) unsigned char bytes[sizeof(StepScratch)];
-  StepScratch* scratch = nullptr;
-};
-static_assert(std::is_trivially_destructible_v<StepScratchSlot>);
-thread_local StepScratchSlot tStepScratch;
+thread_local internal::ThreadLocalSlot<StepScratch> tStepScratch;
+static_assert(std::is_trivially_destructible_v<internal::ThreadLocalSlot<StepScratch>>);
 
 // This thread's step scratch. Real-time safe: yes (no allocation).
-StepScratch& stepScratch() noexcept {
-  StepScratchSlot& slot = tStepScratch;
-  if (slot.scratch == nullptr) slot.scratch = new (slot.bytes) StepScratch();
-  return *slot.scratch;
-}
+StepScratch& stepScratch() noexcept { return tStepScratch.getOrMake(); }
 
 }  // namespace
 
@@ -345,7 +335,7 @@ void ManipulatorSimulation::dynamics(const JointVector& tau) {
   StepScratch& s = stepScratch();
   s.payloadBias = tau - stepMass_ * inverseDynamics(*u.model, *u.data, q_, qd_, zero_);
   forwardDynamics(model_, d, q_, qd_, s.payloadBias, options_);
-  s.payloadBias.noalias() = d.massMatrix * d.qdd;
+  symmetricTimes(d.massMatrix, d.qdd, s.payloadBias);
   s.payloadMass = d.massMatrix + stepMass_ * massMatrix(*u.model, *u.data, q_);
   s.L.resize(s.payloadMass.rows(), s.payloadMass.cols());
   choleskySolve(s.payloadMass, s.payloadBias, s.L, d.qdd);
@@ -541,7 +531,7 @@ void ManipulatorSimulation::eulerStep(double h) {
     // starts from is tried first.
     sc.residual.resize(n);
     for (int i = 0; i < n; ++i) sc.residual(i) = h * (sc.diag(i) * sc.v0(i) - viscous_(i) * qd_(i));
-    sc.startMode = contactMode(qd_);
+    sc.start = qd_;
     qd_ = sc.v0;
     solveFriction(h);
   } else if (sc.diag.cwiseAbs().maxCoeff() > 0) {
@@ -589,7 +579,7 @@ void ManipulatorSimulation::rk4Step(double h) {
     symmetricTimes(sc.A, qd_, sc.rhs);
     sc.residual.setZero(n);  // A qd - rhs
     sc.kv = qd_;
-    sc.startMode = contactMode(sc.v0);
+    sc.start = sc.v0;
     solveFriction(h);
     for (int i = 0; i < n; ++i)
       q_(i) = (sc.v0(i) == 0 && qd_(i) == 0) ? sc.q0(i) : q_(i) + 0.5 * h * (qd_(i) - sc.kv(i));
@@ -615,17 +605,13 @@ void ManipulatorSimulation::solveFriction(double h) {
   // The contact mode of the velocities the step started from (which joints stuck, which way the
   // others slid) is usually the minimiser's: that mode's exact solution, if it is optimal, needs
   // no sweep (and is the sweeps' result too: the minimiser is unique, and a mode's solution
-  // depends on the mode alone).
-  sc.kq.resize(n);
-  for (int i = 0; i < n; ++i) {
-    const std::uint64_t bits = (sc.startMode >> (2 * i)) & 3;
-    sc.kq(i) = bits == 1 ? 1.0 : bits == 2 ? -1.0 : 0.0;
-  }
-  if (solveContactMode(A, sc.rhs, sc.upper, sc.lower, sc.kq)) {
-    qd_ = sc.kq;
+  // depends on the mode alone). solveContactMode() replaces `start` by it then.
+  const std::uint64_t startMode = contactMode(sc.start);
+  if (solveContactMode(A, sc.rhs, sc.upper, sc.lower, sc.start)) {
+    qd_ = sc.start;
     return;
   }
-  std::uint64_t lastMode = contactMode(qd_), triedMode = sc.startMode;
+  std::uint64_t lastMode = contactMode(qd_), triedMode = startMode;
   for (int sweep = 0; sweep < kMaxFrictionSweeps; ++sweep) {
     double change = 0;
     for (int i = 0; i < n; ++i) {
