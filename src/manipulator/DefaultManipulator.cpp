@@ -59,7 +59,7 @@ namespace {
 constexpr double kRestVelocity = 1e-3;  // [rad/s] below which the arm counts as at rest
 constexpr double kRestDuration = 0.05;  // [s] at rest before the power goes off in a shutdown
 constexpr double kShutdownTimeout = 3.0;  // [s] longest damped hold
-constexpr int kMaxCatchUpSteps = 1000;    // longest stall the simulation integrates, in periods
+constexpr int kMaxCatchUpPeriods = 1000;  // longest stall the simulation integrates, in periods
 constexpr double kSwitchRestVelocity = 0.01;  // [rad/s] at rest enough to leave the hardware
 constexpr double kVelocityCutoffHz = 50.0;    // a hardware arm's velocity filter (second order)
 
@@ -890,6 +890,23 @@ void DefaultManipulator::readInputs() {
     }
   }
 
+  // The simulation integrates the time since the last cycle under that cycle's torque (tau_),
+  // before this cycle changes the brakes: one step of one period normally, the step the last
+  // cycle's write phase used to take. On the real clock a cycle delayed by a busy machine skips
+  // deadlines; the arm moved on under the last torque meanwhile, as a real one does: the whole time
+  // since the last cycle is integrated (ManipulatorSimulation::advance(): in steps of up to 4
+  // periods). One step covers a few skipped deadlines: the cycle after an overrun costs what any
+  // cycle costs, and an executor loaded near its period recovers. (With one step per skipped
+  // period, the cycle after an overrun took two steps, overran in turn, and an executor above
+  // about 60 % load ran every other deadline for good.)
+  if (!board_ && lastCycleTime_ >= 0) {
+    if (simulatedClock_ != nullptr) {
+      sim_->step(tau_, dt);
+    } else {
+      (void)sim_->advance(tau_, std::min(t - lastCycleTime_, (kMaxCatchUpPeriods + 1) * dt), dt);
+    }
+  }
+
   // 1. Commands from other threads, then the joints.
   int phase = shutdownPhase_.load(std::memory_order_acquire);
   const bool wantPower =
@@ -914,13 +931,6 @@ void DefaultManipulator::readInputs() {
         readTime_ = 1e-9 * static_cast<double>(lastSampleTime_ - real.epochNanoseconds());
     }
   } else {
-    // On the real clock a cycle delayed by a busy machine skips deadlines; the arm moved on under
-    // the last torque (still in tau_) meanwhile, as a real one does: integrate that time, in
-    // steps of one period, before reading the joints.
-    if (simulatedClock_ == nullptr && lastCycleTime_ >= 0 && t - lastCycleTime_ > 1.5 * dt) {
-      const int skipped = std::min(kMaxCatchUpSteps, static_cast<int>(std::lround((t - lastCycleTime_) / dt)) - 1);
-      for (int k = 0; k < skipped; ++k) sim_->step(tau_, dt);
-    }
     if (wrench_->read(n + 1)) applyWrenches(n);
     q_ = sim_->getPosition();
     qd_ = sim_->getVelocity();
@@ -1047,16 +1057,13 @@ void DefaultManipulator::control() {
   }
 }
 
-void DefaultManipulator::writeOutputs() { finishCycle(getTime(), getPeriod()); }
+void DefaultManipulator::writeOutputs() { finishCycle(getTime()); }
 
-void DefaultManipulator::finishCycle(double t, double dt) {
-  // 5. Output: no torque without power; the simulation integrates the dynamics over one period.
+void DefaultManipulator::finishCycle(double t) {
+  // 5. Output: no torque without power. The simulation integrates this torque at the next cycle's
+  // read (readInputs()), over the time that really passed until then.
   if (!power_) tau_.setZero();
-  if (board_) {
-    writeHardware();
-  } else {
-    sim_->step(tau_, dt);
-  }
+  if (board_) writeHardware();
   lastCycleTime_ = t;
 
   // 6. State for other threads (log samples are taken by the ControlProgram after control()).

@@ -448,6 +448,16 @@ void ManipulatorSimulation::step(const JointVector& tau, double dt) {
   recordReading();
 }
 
+int ManipulatorSimulation::advance(const JointVector& tau, double elapsed, double period) {
+  if (elapsed < 1.5 * period) {
+    step(tau, period);
+    return 1;
+  }
+  const int steps = static_cast<int>(std::ceil(elapsed / (kCatchUpStepPeriods * period)));
+  for (int k = 0; k < steps; ++k) step(tau, elapsed / steps);
+  return steps;
+}
+
 void ManipulatorSimulation::setExternalLinkWrench(int link, const Vector<3>& point, const Vector<6>& wrench) {
   const int n = model_.getNumberOfJoints();
   if (link < 1 || link > n) {

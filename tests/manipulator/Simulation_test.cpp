@@ -490,6 +490,43 @@ TEST(SimulationIntegrator, Rk4IsFarMoreAccurateThanEulerInFreeMotion) {
   }
 }
 
+// A servo cycle that skipped deadlines integrates the time that passed in a few steps
+// (ManipulatorSimulation::advance(): at most 4 periods each), not one step per deadline: the cycle
+// after an overrun then costs what any cycle costs. A cycle on time takes the very step step()
+// takes; a late one moves the arm through the whole interval, as a fine integration of the same
+// interval does (the reference: 0.1 ms steps).
+TEST(SimulationIntegrator, ACycleAfterSkippedDeadlinesIntegratesTheWholeIntervalInAFewSteps) {
+  Puma560Model model;
+  const double dt = 1e-3;
+  JointVector q0 = model.getHomePosition(), v0(6), tau(6);
+  v0 << 0.5, -0.4, 0.3, 0.8, -0.6, 1.0;
+  tau << 20, 40, 10, 1, 1, 0.5;
+  for (const auto& [elapsed, steps] : std::vector<std::pair<double, int>>{
+           {dt, 1}, {1.4 * dt, 1}, {2 * dt, 1}, {4 * dt, 1}, {5 * dt, 2}, {8 * dt, 2}, {60 * dt, 15}}) {
+    ManipulatorSimulation late(model), fine(model);
+    late.setState(q0, v0);
+    fine.setState(q0, v0);
+    EXPECT_EQ(late.advance(tau, elapsed, dt), steps) << elapsed / dt << " periods";
+    if (elapsed < 1.5 * dt) {
+      // On time (within half a period): the step of one period, bit for bit.
+      fine.step(tau, dt);
+      EXPECT_EQ(late.getTruePosition(), fine.getTruePosition());
+      EXPECT_EQ(late.getTrueVelocity(), fine.getTrueVelocity());
+      continue;
+    }
+    const int fineSteps = static_cast<int>(std::lround(elapsed / 1e-4));
+    for (int k = 0; k < fineSteps; ++k) fine.step(tau, 1e-4);
+    const double moved = (fine.getTruePosition() - q0).cwiseAbs().maxCoeff();
+    const double error = (late.getTruePosition() - fine.getTruePosition()).cwiseAbs().maxCoeff();
+    const double velocityChange = (fine.getTrueVelocity() - v0).cwiseAbs().maxCoeff();
+    const double velocityError = (late.getTrueVelocity() - fine.getTrueVelocity()).cwiseAbs().maxCoeff();
+    std::printf("  %4.0f periods: moved %.3g rad, error %.2g rad; velocity change %.3g rad/s, error %.2g rad/s\n",
+                elapsed / dt, moved, error, velocityChange, velocityError);
+    EXPECT_LT(error, 0.01 * moved) << elapsed / dt << " periods";
+    EXPECT_LT(velocityError, 0.03 * velocityChange) << elapsed / dt << " periods";
+  }
+}
+
 // ---- A plant that differs from the controller's model -------------------------------------------
 
 const ConfigSection& section(const Configuration& config) { return config.sections().front(); }

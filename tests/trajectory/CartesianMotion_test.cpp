@@ -25,11 +25,11 @@ const Transform kWorkPose = translation(0.5, 0.2, 0.3) * xRotation(std::numbers:
 class CartesianMotionTest : public test::SimulatedArmTest {
  protected:
   SimulatedClock& clock() { return test::simClock(); }
-  // Pauses the clock once the arm's loop has run its first cycle; the test then drives time.
-  void takeOver(DefaultManipulator& m) {
-    clock().pause();
-    while (m.getCycleCount() < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
+  // Runs the arm's loop for one cycle, after which the cycle itself pauses the clock
+  // (runCycles()); the test then drives time. (Pausing the clock from the test thread once a cycle
+  // had run raced with the next tick, already given: that cycle could run during the test's own
+  // evaluation of the generator.)
+  void takeOver(DefaultManipulator& m) { ASSERT_TRUE(m.runCycles(1)); }
 };
 
 // Three Puma joint targets [deg] around a gentle corner: every joint keeps its direction.

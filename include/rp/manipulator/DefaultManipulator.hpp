@@ -26,8 +26,9 @@ class SimulatedClock;
 /// A manipulator whose servo loop is a ControlProgram, started when the object is created (paper
 /// Figure 11) and stepped by the executor thread of its rate with every other arm of that rate
 /// (or in a thread of its own: rp.cfg `thread own`; docs/realtime.md, Executors). Every cycle:
-/// 1. read the joints (from the arm, or from the dynamic simulation in simulation mode): the read
-///    phase, readInputs(), before any program of the executor computes;
+/// 1. read the joints (from the arm, or from the dynamic simulation in simulation mode, which first
+///    integrates the time since the last cycle under its torques: ManipulatorSimulation::advance()
+///    on the real clock): the read phase, readInputs(), before any program of the executor computes;
 /// 2. get the setpoint from the trajectory generator (hold the current position when there is
 ///    none; see the hand-overs below);
 /// 3. run the servo control (a DefaultPositionControl unless switched), plus the gravity torque
@@ -40,8 +41,9 @@ class SimulatedClock;
 ///    message in the error status); a joint reading that is not a number switches the power off
 ///    at once;
 ///    (steps 2 to 4 are the control phase, control());
-/// 5. output the torques (to the amplifiers, or integrate the model's forward dynamics): the write
-///    phase, writeOutputs(), after every program of the executor has computed;
+/// 5. output the torques (to the amplifiers, or to the simulation, which integrates them at the next
+///    cycle's read over the time that really passed): the write phase, writeOutputs(), after every
+///    program of the executor has computed;
 /// 6. publish the state for other threads and sample the log variables `q`, `qd`, `qdes`,
 ///    `qddes`, `qdddes`, `tau`, `saturated` and `missed` (deadlines skipped so far).
 ///
@@ -252,8 +254,8 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   /// The compute phase: the setpoint, the servo control, gravity, saturation, the limits and the
   /// shutdown's hold.
   void control() override;
-  /// The write phase: the torques to the amplifiers (or one step of the simulation), then the
-  /// state for other threads.
+  /// The write phase: the torques to the amplifiers (a simulation integrates them at the next
+  /// read), then the state for other threads.
   void writeOutputs() override;
   void exitControl() override;
   /// Rebuilds the model and switches simulation and hardware after a change of pose, mount or
@@ -299,7 +301,7 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   void gravityWithPayload();  // gravity_ at q_, with the payload's weight
   void saturate() noexcept;  // tau_ within the torque limits; saturatedJoints_ counts the joints
   void powerOffNow() noexcept;
-  void finishCycle(double t, double dt);
+  void finishCycle(double t);
   void holdUntilSafe();
   void publish();
   bool readHardware(double elapsed);

@@ -107,6 +107,22 @@ class ManipulatorSimulation {
   /// @param[in] dt   time step [s] (> 0)
   /// Real-time safe: yes.
   void step(const JointVector& tau, double dt);
+  /// Longest step advance() takes over skipped deadlines, in periods.
+  static constexpr int kCatchUpStepPeriods = 4;
+  /// Advances the simulation by the time `elapsed` that passed since the last step of a servo loop
+  /// of period `period`, under the joint torques `tau` (that loop's last output): one step of
+  /// exactly `period` when `elapsed` is within half a period of it, as in a cycle on time;
+  /// otherwise (a cycle that skipped deadlines: the arm moved on under the last torque meanwhile)
+  /// the fewest equal steps of at most kCatchUpStepPeriods periods that cover `elapsed`. A late
+  /// cycle then costs a step, not one step per skipped deadline: a servo loop loaded near its
+  /// period recovers from an overrun instead of overrunning again to catch up. Each step takes
+  /// one sensor reading.
+  /// @param[in] tau      motor torques at the joints (n x 1) [N m]
+  /// @param[in] elapsed  time since the last step [s] (> 0)
+  /// @param[in] period   the servo period [s] (> 0)
+  /// @return the number of steps taken
+  /// Real-time safe: yes.
+  int advance(const JointVector& tau, double elapsed, double period);
 
   /// Joint positions as the simulated encoders read them (n x 1) [rad]: the plant's, quantised to
   /// the encoder resolution and as old as the sensor delay (see setSensor()); the true positions
