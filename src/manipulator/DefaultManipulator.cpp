@@ -59,7 +59,6 @@ namespace {
 constexpr double kRestVelocity = 1e-3;  // [rad/s] below which the arm counts as at rest
 constexpr double kRestDuration = 0.05;  // [s] at rest before the power goes off in a shutdown
 constexpr double kShutdownTimeout = 3.0;  // [s] longest damped hold
-constexpr int kMaxCatchUpPeriods = 1000;  // longest stall the simulation integrates, in periods
 constexpr double kSwitchRestVelocity = 0.01;  // [rad/s] at rest enough to leave the hardware
 constexpr double kVelocityCutoffHz = 50.0;    // a hardware arm's velocity filter (second order)
 
@@ -903,7 +902,7 @@ void DefaultManipulator::readInputs() {
     if (simulatedClock_ != nullptr) {
       sim_->step(tau_, dt);
     } else {
-      (void)sim_->advance(tau_, std::min(t - lastCycleTime_, (kMaxCatchUpPeriods + 1) * dt), dt);
+      (void)sim_->advance(tau_, t - lastCycleTime_, dt);
     }
   }
 

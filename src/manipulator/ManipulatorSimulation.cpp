@@ -356,7 +356,7 @@ void ManipulatorSimulation::setState(const JointVector& q, const JointVector& qd
   qdd_.setZero();
   for (int k = 0; k <= delay_; ++k) {
     head_ = k;
-    recordReading();
+    recordReading(q_, qd_);
   }
 }
 
@@ -393,9 +393,14 @@ void ManipulatorSimulation::setEncoderOffset(const JointVector& offset) {
 }
 
 void ManipulatorSimulation::recordReading() {
+  head_ = head_ == delay_ ? 0 : head_ + 1;
+  recordReading(q_, qd_);
+}
+
+void ManipulatorSimulation::recordReading(const JointVector& q, const JointVector& qd) {
   Reading& r = readings_[static_cast<std::size_t>(head_)];
-  r.position = q_ + encoderOffset_;
-  r.velocity = qd_;
+  r.position = q + encoderOffset_;
+  r.velocity = qd;
   // An encoder counts whole increments: the reading is the count below the position.
   for (int i = 0; i < countsPerRadian_.size(); ++i)
     if (std::isfinite(countsPerRadian_(i)))
@@ -414,6 +419,11 @@ void ManipulatorSimulation::setBrakeTorque(const JointVector& torque) {
 }
 
 void ManipulatorSimulation::step(const JointVector& tau, double dt) {
+  integrate(tau, dt);
+  recordReading();
+}
+
+void ManipulatorSimulation::integrate(const JointVector& tau, double dt) {
   const int n = model_.getNumberOfJoints();
   takePayload();
   externalTorque();  // constant over the step
@@ -444,17 +454,33 @@ void ManipulatorSimulation::step(const JointVector& tau, double dt) {
     const double h = dt / substeps;
     for (int s = 0; s < substeps; ++s) eulerStep(h);
   }
-  head_ = head_ == delay_ ? 0 : head_ + 1;
-  recordReading();
 }
 
 int ManipulatorSimulation::advance(const JointVector& tau, double elapsed, double period) {
-  if (elapsed < 1.5 * period) {
+  if (!(period > 0) || !std::isfinite(period))
+    throw std::invalid_argument("ManipulatorSimulation::advance: the period must be positive and finite");
+  if (!(elapsed >= 1.5 * period)) {  // on time (and a time that is not a number)
     step(tau, period);
     return 1;
   }
-  const int steps = static_cast<int>(std::ceil(elapsed / (kCatchUpStepPeriods * period)));
-  for (int k = 0; k < steps; ++k) step(tau, elapsed / steps);
+  const int periods = static_cast<int>(std::lround(std::min(elapsed, kMaxCatchUpPeriods * period) / period));
+  const int steps = (periods + kCatchUpStepPeriods - 1) / kCatchUpStepPeriods;
+  const double h = elapsed < kMaxCatchUpPeriods * period ? elapsed / steps : period * periods / steps;
+  int read = 0;  // readings taken, one per period
+  for (int k = 1; k <= steps; ++k) {
+    const JointVector q0 = q_, v0 = qd_;  // the step's start, for the readings within it
+    integrate(tau, h);
+    // The periods this step covers (the steps share them out evenly), each with a reading: the
+    // state interpolated between the step's ends, the last one the step's end.
+    const int within = periods * k / steps - read;
+    for (int j = 1; delay_ > 0 && j < within; ++j) {  // (without a delay only the last reading is kept)
+      const double f = static_cast<double>(j) / within;
+      head_ = head_ == delay_ ? 0 : head_ + 1;
+      recordReading(q0 + f * (q_ - q0), v0 + f * (qd_ - v0));
+    }
+    recordReading();
+    read += within;
+  }
   return steps;
 }
 

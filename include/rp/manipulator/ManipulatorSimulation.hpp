@@ -109,18 +109,24 @@ class ManipulatorSimulation {
   void step(const JointVector& tau, double dt);
   /// Longest step advance() takes over skipped deadlines, in periods.
   static constexpr int kCatchUpStepPeriods = 4;
+  /// Longest time advance() integrates, in periods (a longer gap, such as a stop in a debugger,
+  /// integrates this much of it).
+  static constexpr int kMaxCatchUpPeriods = 1000;
   /// Advances the simulation by the time `elapsed` that passed since the last step of a servo loop
   /// of period `period`, under the joint torques `tau` (that loop's last output): one step of
-  /// exactly `period` when `elapsed` is within half a period of it, as in a cycle on time;
-  /// otherwise (a cycle that skipped deadlines: the arm moved on under the last torque meanwhile)
-  /// the fewest equal steps of at most kCatchUpStepPeriods periods that cover `elapsed`. A late
-  /// cycle then costs a step, not one step per skipped deadline: a servo loop loaded near its
-  /// period recovers from an overrun instead of overrunning again to catch up. Each step takes
-  /// one sensor reading.
+  /// exactly `period` when `elapsed` is under 1.5 periods, as in a cycle on time; otherwise (a
+  /// cycle that skipped deadlines: the arm moved on under the last torque meanwhile) the fewest
+  /// equal steps of at most kCatchUpStepPeriods periods that cover `elapsed` (at most
+  /// kMaxCatchUpPeriods periods of it). A late cycle then costs a step, not one step per skipped
+  /// deadline: a servo loop loaded near its period recovers from an overrun instead of overrunning
+  /// again to catch up. The sensors still take one reading per period (a step of several periods
+  /// gives the ones within it interpolated between its start and its end), so that a sensor delay
+  /// (setSensor()) stays that many periods.
   /// @param[in] tau      motor torques at the joints (n x 1) [N m]
-  /// @param[in] elapsed  time since the last step [s] (> 0)
-  /// @param[in] period   the servo period [s] (> 0)
+  /// @param[in] elapsed  time since the last step [s]
+  /// @param[in] period   the servo period [s] (> 0 and finite)
   /// @return the number of steps taken
+  /// @throws std::invalid_argument for a period that is not positive and finite
   /// Real-time safe: yes.
   int advance(const JointVector& tau, double elapsed, double period);
 
@@ -146,7 +152,9 @@ class ManipulatorSimulation {
   /// Sets the simulated sensors. Real-time safe: no.
   /// @param[in] countsPerRadian  encoder resolution per joint [counts/rad] (n x 1, each > 0, or
   ///                             infinite for exact readings); empty: exact readings
-  /// @param[in] delay            steps between the plant's state and its reading (0..kMaxSensorDelay)
+  /// @param[in] delay            readings between the plant's state and its reading
+  ///                             (0..kMaxSensorDelay): one reading per step(), one per period in
+  ///                             advance()
   /// @throws std::invalid_argument on a wrong size, a resolution that is not positive, or a delay
   ///         out of range
   void setSensor(const JointVector& countsPerRadian, int delay);
@@ -231,7 +239,9 @@ class ManipulatorSimulation {
   void eulerStep(double h);
   void rk4Step(double h);
   void solveFriction(double h);
-  void recordReading();
+  void integrate(const JointVector& tau, double dt);  // step() without its sensor reading
+  void recordReading();                                  // the next reading, of q_ and qd_
+  void recordReading(const JointVector& q, const JointVector& qd);
   // The oldest reading of the ring (slots 0..delay_), the one the sensor delay gives.
   std::size_t readIndex() const { return static_cast<std::size_t>(head_ == delay_ ? 0 : head_ + 1); }
   void externalTorque();
