@@ -463,9 +463,12 @@ int ManipulatorSimulation::advance(const JointVector& tau, double elapsed, doubl
     step(tau, period);
     return 1;
   }
-  const int periods = static_cast<int>(std::lround(std::min(elapsed, kMaxCatchUpPeriods * period) / period));
-  const int steps = (periods + kCatchUpStepPeriods - 1) / kCatchUpStepPeriods;
-  const double h = elapsed < kMaxCatchUpPeriods * period ? elapsed / steps : period * periods / steps;
+  const double span = std::min(elapsed, kMaxCatchUpPeriods * period);
+  const int periods = static_cast<int>(std::lround(span / period));  // 2 or more
+  // (A gap of whole periods measured on a clock of large times is off by rounding: 4 periods
+  // may come out a hair over 4.)
+  const int steps = static_cast<int>(std::ceil(span / (kCatchUpStepPeriods * period) - 1e-6));  // at most `periods`
+  const double h = span / steps;
   int read = 0;  // readings taken, one per period
   for (int k = 1; k <= steps; ++k) {
     const JointVector q0 = q_, v0 = qd_;  // the step's start, for the readings within it
