@@ -898,13 +898,8 @@ void DefaultManipulator::readInputs() {
   // cycle costs, and an executor loaded near its period recovers. (With one step per skipped
   // period, the cycle after an overrun took two steps, overran in turn, and an executor above
   // about 60 % load ran every other deadline for good.)
-  if (!board_ && lastCycleTime_ >= 0) {
-    if (simulatedClock_ != nullptr) {
-      sim_->step(tau_, dt);
-    } else {
-      (void)sim_->advance(tau_, t - lastCycleTime_, dt);
-    }
-  }
+  // (A simulated clock skips no deadline: one period.)
+  if (!board_ && lastCycleTime_ >= 0) (void)sim_->advance(tau_, simulatedClock_ != nullptr ? dt : t - lastCycleTime_, dt);
 
   // 1. Commands from other threads, then the joints.
   int phase = shutdownPhase_.load(std::memory_order_acquire);

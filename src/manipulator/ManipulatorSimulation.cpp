@@ -354,10 +354,8 @@ void ManipulatorSimulation::setState(const JointVector& q, const JointVector& qd
   q_ = q;
   qd_ = qd;
   qdd_.setZero();
-  for (int k = 0; k <= delay_; ++k) {
-    head_ = k;
-    recordReading(q_, qd_);
-  }
+  head_ = delay_;  // the ring filled with this state, the newest in slot delay_
+  for (int k = 0; k <= delay_; ++k) pushReading(q_, qd_);
 }
 
 void ManipulatorSimulation::setSensor(const JointVector& countsPerRadian, int delay) {
@@ -392,12 +390,8 @@ void ManipulatorSimulation::setEncoderOffset(const JointVector& offset) {
   setState(q_, qd_);
 }
 
-void ManipulatorSimulation::recordReading() {
+void ManipulatorSimulation::pushReading(const JointVector& q, const JointVector& qd) {
   head_ = head_ == delay_ ? 0 : head_ + 1;
-  recordReading(q_, qd_);
-}
-
-void ManipulatorSimulation::recordReading(const JointVector& q, const JointVector& qd) {
   Reading& r = readings_[static_cast<std::size_t>(head_)];
   r.position = q + encoderOffset_;
   r.velocity = qd;
@@ -420,7 +414,7 @@ void ManipulatorSimulation::setBrakeTorque(const JointVector& torque) {
 
 void ManipulatorSimulation::step(const JointVector& tau, double dt) {
   integrate(tau, dt);
-  recordReading();
+  pushReading(q_, qd_);
 }
 
 void ManipulatorSimulation::integrate(const JointVector& tau, double dt) {
@@ -478,10 +472,9 @@ int ManipulatorSimulation::advance(const JointVector& tau, double elapsed, doubl
     const int within = periods * k / steps - read;
     for (int j = 1; delay_ > 0 && j < within; ++j) {  // (without a delay only the last reading is kept)
       const double f = static_cast<double>(j) / within;
-      head_ = head_ == delay_ ? 0 : head_ + 1;
-      recordReading(q0 + f * (q_ - q0), v0 + f * (qd_ - v0));
+      pushReading(q0 + f * (q_ - q0), v0 + f * (qd_ - v0));
     }
-    recordReading();
+    pushReading(q_, qd_);
     read += within;
   }
   return steps;

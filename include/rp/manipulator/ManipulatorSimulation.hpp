@@ -240,8 +240,7 @@ class ManipulatorSimulation {
   void rk4Step(double h);
   void solveFriction(double h);
   void integrate(const JointVector& tau, double dt);  // step() without its sensor reading
-  void recordReading();                                  // the next reading, of q_ and qd_
-  void recordReading(const JointVector& q, const JointVector& qd);
+  void pushReading(const JointVector& q, const JointVector& qd);  // the ring's next reading
   // The oldest reading of the ring (slots 0..delay_), the one the sensor delay gives.
   std::size_t readIndex() const { return static_cast<std::size_t>(head_ == delay_ ? 0 : head_ + 1); }
   void externalTorque();
