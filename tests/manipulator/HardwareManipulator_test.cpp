@@ -195,13 +195,21 @@ TEST_F(HardwareManipulator, TheStateSnapshotHoldsForTheServersSample) {
       EXPECT_LE(s.readTime, latest + 1e-8) << "a sample newer than the server's latest";
       EXPECT_LT(latest - s.readTime, 0.5) << "a sample half a second old";
     }
-    // Stopped: 30 ms of cycles read the last sample, and keep its time.
+    // Stopped: 30 ms of cycles read the last sample, and keep its time. A stop that lands in the
+    // middle of a sample store (the sequence odd) is undone, and the server runs two whole cycles
+    // before the next try. (Stopped again at once, it stayed stuck in that store: the tries added
+    // up past the arm's 500 ms server timeout, and under ASan the arm shut down once.)
     std::int64_t lastNs = -1;
-    for (int attempt = 0; attempt < 100 && lastNs < 0; ++attempt) {  // (again if stopped in a store)
+    for (int attempt = 0; attempt < 100 && lastNs < 0; ++attempt) {
       server.signal(SIGSTOP);
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      lastNs = serversLatest();
-      if (lastNs < 0) server.signal(SIGCONT);
+      lastNs = probe.inputSampleTime();  // stopped: -1 stays -1, no use waiting
+      if (lastNs >= 0) break;
+      server.signal(SIGCONT);
+      const std::uint64_t cycles = probe.serverCycles();
+      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+      while (probe.serverCycles() < cycles + 2 && std::chrono::steady_clock::now() < until)
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
     }
     ASSERT_GT(lastNs, 0) << "the server stopped in the middle of storing a sample, 100 times";
     const double last = onArmsClock(lastNs);
