@@ -237,6 +237,7 @@ struct StepScratch {
   JointVector tauTotal, diag, rhs, residual, upper, lower, q0, v0, kq, kv, sumQ, sumV, payloadBias;
   JointVector start;  // the velocities the step starts from: their contact mode is tried first
   JointMatrix A, L, payloadMass;
+  bool eulerSweeps = false;  // the friction sweeps start from the Euler step's v + h qdd0 (made on need)
 };
 thread_local internal::ThreadLocalSlot<StepScratch> tStepScratch;
 static_assert(std::is_trivially_destructible_v<internal::ThreadLocalSlot<StepScratch>>);
@@ -319,27 +320,46 @@ void ManipulatorSimulation::takePayload() noexcept {
   stepMass_ = stepCentre_ < 0 ? 0.0 : v[0];
 }
 
-// The step's forward dynamics go to this thread's workspace (ThreadWorkspace.hpp: with many arms
-// in one thread, an arm's own data is cold by its next step), or with mimic joints to the
-// simulation's own data: internal::workspaceOr(model_, data_) says which, to the step that reads
-// the results right after.
-void ManipulatorSimulation::dynamics(const JointVector& tau) {
+// The step's dynamics go to this thread's workspace (ThreadWorkspace.hpp: with many arms in one
+// thread, an arm's own data is cold by its next step), or with mimic joints to the simulation's
+// own data: internal::workspaceOr(model_, data_) says which, to the step that reads the results
+// right after.
+void ManipulatorSimulation::dynamics(const JointVector& q, const JointVector& qd, const JointVector& tau, bool solve) {
   ManipulatorData& d = internal::workspaceOr(model_, data_);
   if (stepMass_ == 0) {
-    forwardDynamics(model_, d, q_, qd_, tau, options_);
+    if (solve) {
+      forwardDynamics(model_, d, q, qd, tau, options_);
+      return;
+    }
+    massMatrixAndBias(model_, d, q, qd, options_);
+    for (int i = 0; i < d.n; ++i) d.qdd(i) = tau(i) - d.bias(i);  // forwardDynamics()'s right-hand side
     return;
   }
-  // (M + m M_u) qdd = tau - h - m h_u: the arm's forward dynamics under tau - m h_u gives M and
-  // M qdd' = tau - h - m h_u, which is the right-hand side.
+  // (M + m M_u) qdd = tau - m h_u - h, with the unit payload's M_u and h_u.
   Payload::Unit& u = payload_->units[static_cast<std::size_t>(stepCentre_)];
   StepScratch& s = stepScratch();
-  s.payloadBias = tau - stepMass_ * inverseDynamics(*u.model, *u.data, q_, qd_, zero_);
-  forwardDynamics(model_, d, q_, qd_, s.payloadBias, options_);
-  symmetricTimes(d.massMatrix, d.qdd, s.payloadBias);
-  s.payloadMass = d.massMatrix + stepMass_ * massMatrix(*u.model, *u.data, q_);
-  s.L.resize(s.payloadMass.rows(), s.payloadMass.cols());
-  choleskySolve(s.payloadMass, s.payloadBias, s.L, d.qdd);
-  d.massMatrix = s.payloadMass;
+  s.payloadBias = tau - stepMass_ * inverseDynamics(*u.model, *u.data, q, qd, zero_);
+  massMatrixAndBias(model_, d, q, qd, options_);
+  for (int i = 0; i < d.n; ++i) d.qdd(i) = s.payloadBias(i) - d.bias(i);
+  d.massMatrix += stepMass_ * massMatrix(*u.model, *u.data, q);
+  if (!solve) return;
+  s.payloadBias = d.qdd;
+  s.L.resize(d.massMatrix.rows(), d.massMatrix.cols());
+  choleskySolve(d.massMatrix, s.payloadBias, s.L, d.qdd);
+}
+
+const JointVector& ManipulatorSimulation::getAcceleration() const {
+  if (accelerationPending_) {
+    // Pending only after an Euler step, which a const object cannot have taken: the object is
+    // not const, and the cast is defined.
+    auto& self = const_cast<ManipulatorSimulation&>(*this);
+    const int n = model_.getNumberOfJoints();
+    const JointVector q = stepStart_.col(0).head(n), qd = stepStart_.col(1).head(n), tau = stepStart_.col(2).head(n);
+    self.dynamics(q, qd, tau, true);
+    self.qdd_ = internal::workspaceOr(model_, self.data_).qdd;
+    self.accelerationPending_ = false;
+  }
+  return qdd_;
 }
 
 const JointMatrix& ManipulatorSimulation::plantMassMatrix() {
@@ -354,6 +374,7 @@ void ManipulatorSimulation::setState(const JointVector& q, const JointVector& qd
   q_ = q;
   qd_ = qd;
   qdd_.setZero();
+  accelerationPending_ = false;
   head_ = delay_;  // the ring filled with this state, the newest in slot delay_
   for (int k = 0; k <= delay_; ++k) pushReading(q_, qd_);
 }
@@ -532,14 +553,24 @@ void ManipulatorSimulation::eulerStep(double h) {
   // joint would cross its limit (q + h v beyond it): a joint never enters a stop by a whole step's
   // travel unopposed (that would store spring energy it never had).
   sc.tauTotal = tauApplied_ - viscous_.cwiseProduct(qd_);
+  bool implicit = hasCoulomb_ || brakes_;  // a term implicit in v+ (else v+ = v + h qdd0)
   for (int i = 0; i < n; ++i) {
     const double lo = model_.getPositionMin()(i), hi = model_.getPositionMax()(i), next = q_(i) + h * qd_(i);
     engaged_[static_cast<std::size_t>(i)] = q_(i) < lo || q_(i) > hi || next < lo || next > hi;
+    implicit = implicit || viscous_(i) != 0 || engaged_[static_cast<std::size_t>(i)];
     if (!engaged_[static_cast<std::size_t>(i)]) continue;
     sc.tauTotal(i) += k * ((q_(i) > hi || next > hi ? hi : lo) - q_(i));
   }
-  dynamics(sc.tauTotal);
   const ManipulatorData& d = internal::workspaceOr(model_, data_);
+  if (!implicit) {  // no friction, no stop: the explicit step, from the forward dynamics solved
+    dynamics(q_, qd_, sc.tauTotal, true);
+    qdd_ = d.qdd;
+    accelerationPending_ = false;
+    qd_ += h * qdd_;
+    q_ += h * qd_;
+    return;
+  }
+  dynamics(q_, qd_, sc.tauTotal, false);  // M, and r = tauTotal - h in d.qdd (not solved)
   const JointMatrix& M = d.massMatrix;
   sc.diag.resize(n);
   for (int i = 0; i < n; ++i) {
@@ -547,31 +578,29 @@ void ManipulatorSimulation::eulerStep(double h) {
     // A stop critically damped for the joint's inertia at the stop.
     if (engaged_[static_cast<std::size_t>(i)]) sc.diag(i) += 2.0 * std::sqrt(k * M(i, i)) + h * k;
   }
-  // qdd0 with the viscous torque at the start of the step (what getAcceleration() reports), so
-  // the right-hand side adds it back: M (v + h qdd0) + h b v.
-  qdd_ = d.qdd;
-  sc.v0 = qd_ + h * qdd_;
-  symmetricTimes(M, sc.v0, sc.rhs);
-  sc.rhs += h * viscous_.cwiseProduct(qd_);
+  // The accelerations at the start of the step, M^-1 r (getAcceleration()), are solved for only
+  // when asked: the step below needs M and r, not them.
+  stepStart_.resize(n, 3);
+  stepStart_.col(0) = q_;
+  stepStart_.col(1) = qd_;
+  stepStart_.col(2) = sc.tauTotal;
+  accelerationPending_ = true;
+  // With qdd0 = M^-1 r (the viscous torque in r at the start of the step, so the right-hand side
+  // adds it back): M (v + h qdd0) + h b v = M v + h (r + b v).
+  symmetricTimes(M, qd_, sc.rhs);
+  for (int i = 0; i < n; ++i) sc.rhs(i) += h * (d.qdd(i) + viscous_(i) * qd_(i));
   sc.A = M;
   for (int i = 0; i < n; ++i) sc.A(i, i) += h * sc.diag(i);
   if (hasCoulomb_ || brakes_) {
-    // The friction problem's solution is exact from any start (solveFriction() ends with the
-    // exact solution of its contact mode): it starts from v0, whose residual A v0 - rhs =
-    // h (diag v0 - b v) takes no product with A, and A itself is never factorized (only M, in
-    // the forward dynamics, and the contact mode's rows of A). The mode of the velocities the step
-    // starts from is tried first.
-    sc.residual.resize(n);
-    for (int i = 0; i < n; ++i) sc.residual(i) = h * (sc.diag(i) * sc.v0(i) - viscous_(i) * qd_(i));
+    // The contact mode of the step's start velocities is tried first; the sweeps, if it is not
+    // the minimiser's, start from v + h qdd0 (solveFriction()).
     sc.start = qd_;
-    qd_ = sc.v0;
+    sc.eulerSweeps = true;
     solveFriction(h);
-  } else if (sc.diag.cwiseAbs().maxCoeff() > 0) {
-    // v* = A^-1 rhs by Cholesky (A is positive definite).
+  } else {
+    // v+ = A^-1 rhs by Cholesky (A is positive definite).
     sc.L.resize(n, n);
     choleskySolve(sc.A, sc.rhs, sc.L, qd_);
-  } else {
-    qd_ = sc.v0;  // without implicit terms v* = v0 exactly
   }
   q_ += h * qd_;
 }
@@ -590,10 +619,13 @@ void ManipulatorSimulation::rk4Step(double h) {
   const ManipulatorData& d = internal::workspaceOr(model_, data_);  // where dynamics() leaves its results
   for (int s = 0; s < 4; ++s) {
     sc.tauTotal = tauApplied_ - viscous_.cwiseProduct(qd_);
-    dynamics(sc.tauTotal);
+    dynamics(q_, qd_, sc.tauTotal, true);
     sc.kq = qd_;
     sc.kv = d.qdd;
-    if (s == 0) qdd_ = sc.kv;
+    if (s == 0) {
+      qdd_ = sc.kv;
+      accelerationPending_ = false;
+    }
     const double w = (s == 0 || s == 3) ? 1.0 : 2.0;
     sc.sumQ += w * sc.kq;
     sc.sumV += w * sc.kv;
@@ -612,6 +644,7 @@ void ManipulatorSimulation::rk4Step(double h) {
     sc.residual.setZero(n);  // A qd - rhs
     sc.kv = qd_;
     sc.start = sc.v0;
+    sc.eulerSweeps = false;
     solveFriction(h);
     for (int i = 0; i < n; ++i)
       q_(i) = (sc.v0(i) == 0 && qd_(i) == 0) ? sc.q0(i) : q_(i) + 0.5 * h * (qd_(i) - sc.kv(i));
@@ -620,10 +653,11 @@ void ManipulatorSimulation::rk4Step(double h) {
 
 void ManipulatorSimulation::solveFriction(double h) {
   // Minimise 1/2 v^T A v - rhs^T v + h sum_i f_i(v_i), f_i(v) = F+ v (v > 0), -F- v (v < 0), by
-  // exact coordinate descent from the start in qd_ (its residual A qd_ - rhs in the scratch's
-  // residual, which the caller sets): each coordinate's minimiser is a soft threshold. The
-  // objective is strictly convex, so the sweeps converge to its minimiser; a joint whose holding
-  // torque is within its friction comes out exactly at rest.
+  // exact coordinate descent from a start in qd_ with its residual A qd_ - rhs in the scratch's
+  // residual (the RK4 step sets both; the Euler step's are made below, if the sweeps run): each
+  // coordinate's minimiser is a soft threshold. The objective is strictly convex, so the sweeps
+  // converge to its minimiser; a joint whose holding torque is within its friction comes out
+  // exactly at rest.
   const int n = model_.getNumberOfJoints();
   StepScratch& sc = stepScratch();
   const JointMatrix& A = sc.A;
@@ -642,6 +676,21 @@ void ManipulatorSimulation::solveFriction(double h) {
   if (solveContactMode(A, sc.rhs, sc.upper, sc.lower, sc.start)) {
     qd_ = sc.start;
     return;
+  }
+  if (sc.eulerSweeps) {
+    // The Euler step's sweeps start from its velocity without the implicit terms, v + h qdd0
+    // (qdd0 = M^-1 r: M and r = tau - h in the workspace), closer to the minimiser than v: its
+    // residual A (v + h qdd0) - rhs = h (diag (v + h qdd0) - b v) takes no product with A, and
+    // M is factorized only here, when the start's mode was not the minimiser's.
+    const ManipulatorData& d = internal::workspaceOr(model_, data_);
+    sc.L.resize(n, n);
+    choleskySolve(d.massMatrix, d.qdd, sc.L, sc.v0);  // qdd0
+    sc.residual.resize(n);
+    for (int i = 0; i < n; ++i) {
+      sc.v0(i) = qd_(i) + h * sc.v0(i);
+      sc.residual(i) = h * (sc.diag(i) * sc.v0(i) - viscous_(i) * qd_(i));
+    }
+    qd_ = sc.v0;
   }
   std::uint64_t lastMode = contactMode(qd_), triedMode = startMode;
   for (int sweep = 0; sweep < kMaxFrictionSweeps; ++sweep) {

@@ -449,11 +449,11 @@ void massFromChain(const ManipulatorModel& model, ManipulatorData& data) {
           coupling[a].multiplier * coupling[b].multiplier * Mc(static_cast<int>(a), static_cast<int>(b));
 }
 
-// forwardDynamics() with mimic joints: (S^T M S) qdd = tau - S^T h, with M and h = g + C qd [+ tip
-// wrench] [+ friction] of the chain at S q + o and S qd, summed in forwardDynamics()'s order (so
-// that gravityTorque() at rest again gives exactly zero accelerations).
-const JointVector& coupledForwardDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
-                                          const JointVector& qd, const JointVector& tau, const DynamicsOptions& options) {
+// massMatrixAndBias() with mimic joints: S^T M S and S^T h, with M and h = g + C qd [+ tip wrench]
+// [+ friction] of the chain at S q + o and S qd, h summed in forwardDynamics()'s order (so that
+// gravityTorque() at rest again gives exactly zero accelerations).
+void coupledMassMatrixAndBias(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
+                              const JointVector& qd, const DynamicsOptions& options) {
   const ManipulatorModel& chain = model.getChain();
   ManipulatorData& c = *data.chain;
   forwardKinematics(model, data, q);  // the chain's, at data.chainQ
@@ -472,9 +472,6 @@ const JointVector& coupledForwardDynamics(const ManipulatorModel& model, Manipul
   }
   massFromChain(model, data);
   internal::torqueFromChain(model, c.bias, data.bias);
-  for (int i = 0; i < data.n; ++i) data.qdd(i) = tau(i) - data.bias(i);
-  ldlSolveInPlace(data, data.qdd);
-  return data.qdd;
 }
 
 }  // namespace
@@ -493,9 +490,12 @@ const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& da
   return data.massMatrix;
 }
 
-const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
-                                   const JointVector& qd, const JointVector& tau, const DynamicsOptions& options) {
-  if (model.hasMimicJoints()) return coupledForwardDynamics(model, data, q, qd, tau, options);
+const JointVector& massMatrixAndBias(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
+                                     const JointVector& qd, const DynamicsOptions& options) {
+  if (model.hasMimicJoints()) {
+    coupledMassMatrixAndBias(model, data, q, qd, options);
+    return data.bias;
+  }
   // h = g(q) + C(q, qd) qd [+ tip wrench] [+ friction], summed in that order.
   forwardKinematics(model, data, q);
   if (options.gravity) {
@@ -509,8 +509,14 @@ const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorDat
     double h = data.bias(i) + data.scratchTau(i);
     if (options.friction) h += jointFriction(model.getLink(i), qd(i));
     data.bias(i) = h;
-    data.qdd(i) = tau(i) - h;
   }
+  return data.bias;
+}
+
+const JointVector& forwardDynamics(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
+                                   const JointVector& qd, const JointVector& tau, const DynamicsOptions& options) {
+  massMatrixAndBias(model, data, q, qd, options);
+  for (int i = 0; i < data.n; ++i) data.qdd(i) = tau(i) - data.bias(i);
   ldlSolveInPlace(data, data.qdd);
   return data.qdd;
 }
@@ -519,7 +525,7 @@ const JointVector& forwardDynamicsArticulatedBody(const ManipulatorModel& model,
                                                   const JointVector& q, const JointVector& qd, const JointVector& tau,
                                                   const DynamicsOptions& options) {
   // The articulated-body recursion has no place for a joint that follows another: S^T M S instead.
-  if (model.hasMimicJoints()) return coupledForwardDynamics(model, data, q, qd, tau, options);
+  if (model.hasMimicJoints()) return forwardDynamics(model, data, q, qd, tau, options);
   // Featherstone's articulated-body algorithm with every spatial vector (angular; linear) in world
   // coordinates at the world origin: no coordinate transforms between links, so articulated
   // inertias and bias forces add directly into the parent and accelerations carry over as they are.

@@ -82,6 +82,50 @@ TEST(SimulationFriction, SlidingAccelerationIsTheModelsForwardDynamicsWithFricti
   }
 }
 
+// getAcceleration() after a step of either integrator: the model's forward dynamics at the step's
+// start under the applied torque (clamped to the limits) and the viscous friction, as documented;
+// the Euler step solves for it only when asked, from the start it kept, so a second step, a call
+// before any step and setState() must each give their own.
+TEST(SimulationFriction, TheAccelerationIsTheForwardDynamicsAtTheStepsStart) {
+  std::mt19937 rng(11);
+  for (const auto& model : allArms()) {
+    const int n = model->getNumberOfJoints();
+    ManipulatorData data(*model);
+    DynamicsOptions options;
+    options.motorInertia = true;
+    for (SimulationIntegrator integrator : {SimulationIntegrator::Euler, SimulationIntegrator::RK4}) {
+      ManipulatorSimulation sim(*model);
+      sim.setIntegrator(integrator);
+      EXPECT_EQ(sim.getAcceleration(), JointVector::Zero(n)) << "before any step";
+      for (int trial = 0; trial < 10; ++trial) {
+        JointVector q(n), qd(n), tau(n), viscous(n);
+        for (int i = 0; i < n; ++i) {
+          std::uniform_real_distribution<double> in(model->getPositionMin()(i) + 0.2, model->getPositionMax()(i) - 0.2);
+          q(i) = in(rng);
+          qd(i) = std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+          tau(i) = std::uniform_real_distribution<double>(-1.2, 1.2)(rng) * model->getTorqueLimit()(i);
+          const LinkParameters& l = model->getLink(i);
+          viscous(i) = l.viscousFriction * l.gearRatio * l.gearRatio;
+        }
+        sim.setState(q, qd);
+        EXPECT_EQ(sim.getAcceleration(), JointVector::Zero(n)) << "after setState()";
+        sim.step(tau, 1e-3);
+        const JointVector applied = tau.cwiseMax(-model->getTorqueLimit()).cwiseMin(model->getTorqueLimit());
+        const JointVector expected = forwardDynamics(*model, data, q, qd, applied - viscous.cwiseProduct(qd), options);
+        const double scale = 1 + expected.cwiseAbs().maxCoeff();
+        EXPECT_LT((sim.getAcceleration() - expected).cwiseAbs().maxCoeff(), 1e-9 * scale) << model->getName();
+        EXPECT_EQ(sim.getAcceleration(), sim.getAcceleration()) << "asked twice";
+        // The next step's start is this step's end.
+        const JointVector q1 = sim.getTruePosition(), qd1 = sim.getTrueVelocity();
+        sim.step(tau, 1e-3);
+        const JointVector next = forwardDynamics(*model, data, q1, qd1, applied - viscous.cwiseProduct(qd1), options);
+        EXPECT_LT((sim.getAcceleration() - next).cwiseAbs().maxCoeff(), 1e-9 * scale) << model->getName();
+        EXPECT_GT((next - expected).cwiseAbs().maxCoeff(), 1e-6 * scale) << "the two starts give different accelerations";
+      }
+    }
+  }
+}
+
 // The reference: the model's forward dynamics with Coulomb friction in a fixed contact mode (each
 // joint stuck, sliding up or sliding down), integrated by RK4 at 0.1 ms. The mode at the start is
 // the one that satisfies Coulomb's law (found among all 3^n); along the run the reference checks
@@ -867,6 +911,9 @@ TEST(SimulationRealTime, SteppingDoesNotAllocate) {
         sim->advance(tau, 7e-3, 1e-3);  // a late cycle's few steps, with readings between them
       } else {
         sim->step(tau, 1e-3);
+      }
+      if (k % 3 == 0) {
+        EXPECT_TRUE(sim->getAcceleration().allFinite());  // (solved for when asked after an Euler step)
       }
     }
     EXPECT_EQ(guard.count(), 0u);

@@ -2,7 +2,8 @@
 // modified-DH Puma 560 and of a URDF arm with prismatic joints (standard and modified DH):
 // RNEA = M qdd + C + g, forward dynamics inverts inverse dynamics (and is exactly zero at the
 // gravity equilibrium), the gravity torque is the gradient of the potential energy, the Jacobian
-// matches finite differences of forward kinematics, and J^T F matches the Newton-Euler tip wrench.
+// matches finite differences of forward kinematics, and J^T F matches the Newton-Euler tip wrench;
+// massMatrixAndBias() gives the two sides of the system forwardDynamics() solves.
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
@@ -196,6 +197,53 @@ TEST(Dynamics, ForwardDynamicsIsExactlyZeroAtTheGravityEquilibrium) {
       const JointVector& qdd = forwardDynamics(*robot, sim, q, rest, g, opt);
       for (int i = 0; i < n; ++i) EXPECT_EQ(qdd(i), 0.0) << robot->getName() << " joint " << i + 1;
     }
+  }
+}
+
+// massMatrixAndBias(): the bias torque is the Newton-Euler recursion's torque at zero
+// acceleration (a second algorithm, in link coordinates) with every effect of the options, the
+// mass matrix is massMatrix()'s, and tau - h is exactly the right-hand side forwardDynamics()
+// solves (its solution times M gives it back; at the gravity equilibrium it is exactly zero).
+// Also for an arm with mimic joints, where both go through the full chain.
+TEST(Dynamics, MassMatrixAndBiasAreTheTwoSidesForwardDynamicsSolves) {
+  std::mt19937_64 rng(8);
+  auto all = robots();
+  UrdfOptions o;
+  o.tip = "tool";
+  o.requireDynamics = true;
+  all.push_back(loadUrdf(std::string(RP_TEST_DATA_DIR) + "/mimic_arm.urdf", o));
+  ASSERT_TRUE(all.back()->hasMimicJoints());
+  for (auto& robot : all) {
+    ManipulatorData data(*robot), ref(*robot);
+    const int n = robot->getNumberOfJoints();
+    const JointVector zero = JointVector::Zero(n);
+    for (int trial = 0; trial < 100; ++trial) {
+      const JointVector q = randomJoints(*robot, rng), qd = randomJoints(*robot, rng), tau = randomJoints(*robot, rng);
+      DynamicsOptions opt;
+      opt.motorInertia = trial % 2 == 0;
+      opt.friction = trial % 3 == 0;
+      opt.gravity = trial % 5 != 0;
+      if (trial % 4 == 0) opt.tipWrench << 3, -2, 1, 0.5, -0.4, 0.3;
+      const JointVector h = massMatrixAndBias(*robot, data, q, qd, opt);
+      const JointMatrix M = data.massMatrix;
+      const JointVector rnea = inverseDynamics(*robot, ref, q, qd, zero, opt);  // (the motor inertia times qdd = 0)
+      for (int i = 0; i < n; ++i) EXPECT_NEAR(h(i), rnea(i), 1e-10 * (1 + std::abs(rnea(i)))) << robot->getName();
+      const JointMatrix Mref = massMatrix(*robot, ref, q, opt.motorInertia);
+      EXPECT_LT((M - Mref).cwiseAbs().maxCoeff(), 1e-12 * (1 + Mref.cwiseAbs().maxCoeff())) << robot->getName();
+      const JointVector qdd = forwardDynamics(*robot, ref, q, qd, tau, opt);
+      const JointVector back = M * qdd;
+      for (int i = 0; i < n; ++i)
+        EXPECT_NEAR(back(i), tau(i) - h(i), 1e-9 * (1 + std::abs(tau(i) - h(i)))) << robot->getName();
+      for (int i = 0; i < n; ++i) EXPECT_EQ(ref.bias(i), h(i)) << robot->getName() << ": forwardDynamics()'s h";
+    }
+    // At the gravity equilibrium tau - h is exactly zero.
+    const JointVector q = randomJoints(*robot, rng);
+    JointVector g(n);
+    gravityTorque(*robot, ref, q, g);
+    DynamicsOptions opt;
+    opt.motorInertia = true;
+    const JointVector& h = massMatrixAndBias(*robot, data, q, zero, opt);
+    for (int i = 0; i < n; ++i) EXPECT_EQ(g(i) - h(i), 0.0) << robot->getName() << " joint " << i + 1;
   }
 }
 

@@ -143,8 +143,10 @@ class ManipulatorSimulation {
   const JointVector& getTrueVelocity() const { return qd_; }
   /// Joint accelerations at the start of the last step (or sub-step) (n x 1) [rad/s^2]: the
   /// forward dynamics under the applied and external torques, gravity, viscous friction and the
-  /// stops' springs, before Coulomb friction and brakes. Real-time safe: yes.
-  const JointVector& getAcceleration() const { return qdd_; }
+  /// stops' springs, before Coulomb friction and brakes. The Euler step does not need them: they
+  /// are solved for on the first call after it, in the thread that steps the arm. Real-time safe:
+  /// yes (from the stepping thread).
+  const JointVector& getAcceleration() const;
   /// Puts the arm in `q` [rad] with velocities `qd` [rad/s]; the sensors read that state
   /// (their delay line is filled with it). Real-time safe: yes.
   void setState(const JointVector& q, const JointVector& qd);
@@ -245,7 +247,10 @@ class ManipulatorSimulation {
   std::size_t readIndex() const { return static_cast<std::size_t>(head_ == delay_ ? 0 : head_ + 1); }
   void externalTorque();
   void takePayload() noexcept;  // the payload of setPayload(), at the start of a step
-  void dynamics(const JointVector& tau);  // forward dynamics with the payload: data_.qdd, data_.massMatrix
+  // The plant's dynamics at (q, qd) under tau, with the payload, in the stepping thread's
+  // workspace: its massMatrix, and in its qdd the accelerations (solve) or the right-hand side
+  // tau - h that gives them.
+  void dynamics(const JointVector& q, const JointVector& qd, const JointVector& tau, bool solve);
   const JointMatrix& plantMassMatrix();   // the mass matrix at q_ with motor inertia and the payload
 
   // What every step reads and writes comes first, and what only some steps use (a payload, link
@@ -255,7 +260,11 @@ class ManipulatorSimulation {
   // (ManipulatorSimulation.cpp): it stays in that thread's caches from one arm to the next.
   std::unique_ptr<const ManipulatorModel> own_;  // the plant's model when it deviates (before model_)
   const ManipulatorModel& model_;
-  JointVector q_, qd_, qdd_, tauExt_, tauApplied_, coulombPos_, coulombNeg_, brakeTorque_, viscous_;
+  JointVector q_, qd_, tauExt_, tauApplied_, coulombPos_, coulombNeg_, brakeTorque_, viscous_;
+  // The last Euler step's start (q, qd, torque: columns of n rows, contiguous), from which
+  // getAcceleration() solves for the accelerations when accelerationPending_.
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::ColMajor, kMaxJoints, 3> stepStart_;
+  bool accelerationPending_ = false;
   std::array<bool, kMaxJoints> engaged_{};  // joints whose stop acts in the current Euler step
   Vector<6> wrench_;
   int linkWrenches_ = 0;  // number of links with a non-zero wrench
@@ -281,6 +290,7 @@ class ManipulatorSimulation {
   struct Payload;  // the unit point-mass models by centre and the hand-over
   std::unique_ptr<Payload> payload_;
   JointVector zero_;  // zero accelerations (the payload's bias torques)
+  JointVector qdd_;  // the accelerations getAcceleration() returns
   std::array<Vector<3>, kMaxJoints> linkPoint_{};
   std::array<Vector<6>, kMaxJoints> linkWrench_{};
 };

@@ -75,18 +75,38 @@ void coriolisTorque(const ManipulatorModel& model, ManipulatorData& data, const 
 const JointMatrix& massMatrix(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
                               bool motorInertia = false);
 
+/// The two parts of the equations of motion \f$M(q)\ddot q + h(q, \dot q) = \tau\f$ that
+/// forwardDynamics() solves, without solving them: the mass matrix \f$M\f$ (with motorInertia,
+/// including \f$G^2 J_m\f$) and the bias torque \f$h = g(q) + C(q, \dot q)\dot q\f$ plus the
+/// other effects in `options` (as forwardDynamics() computes them, so that \f$\tau - h\f$ is the
+/// right-hand side it solves, to the last bit). For an integrator that solves its own system with
+/// \f$M\f$ (e.g. an Euler step \f$\Delta t\f$ with implicit damping \f$D\f$:
+/// \f$(M + \Delta t\,D)\,\dot q^+ = M\dot q + \Delta t\,(\tau - h)\f$) or a controller that
+/// needs \f$M\f$ and \f$h\f$ together (computed torque, operational-space control): one
+/// forward kinematics for both.
+/// @param[in]  model    the manipulator
+/// @param[out] data     receives `massMatrix` (n x n) [kg m^2], `bias` (n x 1) [N m or N] and the
+///                      forward kinematics of `q`
+/// @param[in]  q        joint positions (n x 1) [rad or m]
+/// @param[in]  qd       joint velocities (n x 1) [rad/s or m/s]
+/// @param[in]  options  effects to include (`gravity`, `motorInertia`, `friction`, `tipWrench`)
+/// @return `data.bias` [N m or N]
+/// Real-time safe: yes.
+const JointVector& massMatrixAndBias(const ManipulatorModel& model, ManipulatorData& data, const JointVector& q,
+                                     const JointVector& qd, const DynamicsOptions& options = DynamicsOptions());
+
 /// Forward dynamics: the accelerations \f$\ddot q = M^{-1}(\tau - h(q, \dot q))\f$ that the
 /// torques `tau` produce, with \f$h = g(q) + C(q, \dot q)\dot q\f$ plus the effects in `options`
 /// (with motorInertia, \f$M\f$ includes \f$G^2 J_m\f$). All in world coordinates after one
 /// forward kinematics: \f$g\f$ by the same routine as gravityTorque(), \f$C \dot q\f$ by a
 /// Newton-Euler pass on spatial vectors, \f$M\f$ by the composite-rigid-body algorithm as in
-/// massMatrix(), and an unpivoted LDL^T solve (\f$M\f$ is positive definite). At an equilibrium
-/// (`tau` equal to gravityTorque() of `q`, \f$\dot q = 0\f$) the accelerations are exactly
-/// zero, since the same numbers are subtracted; simulations with discontinuous Coulomb friction
-/// rely on that. forwardDynamicsArticulatedBody() computes \f$g\f$ differently and leaves
-/// rounding residues there.
+/// massMatrix() (massMatrixAndBias() gives these two), and an unpivoted LDL^T solve (\f$M\f$ is
+/// positive definite). At an equilibrium (`tau` equal to gravityTorque() of `q`,
+/// \f$\dot q = 0\f$) the accelerations are exactly zero, since the same numbers are subtracted;
+/// simulations with discontinuous Coulomb friction rely on that. forwardDynamicsArticulatedBody()
+/// computes \f$g\f$ differently and leaves rounding residues there.
 /// @param[in]  model    the manipulator
-/// @param[out] data     receives `qdd`, `massMatrix` and the forward kinematics of `q`
+/// @param[out] data     receives `qdd`, `massMatrix`, `bias` and the forward kinematics of `q`
 /// @param[in]  q        joint positions (n x 1) [rad or m]
 /// @param[in]  qd       joint velocities (n x 1) [rad/s or m/s]
 /// @param[in]  tau      applied joint torques (n x 1) [N m or N]

@@ -31,7 +31,8 @@ struct ManipulatorData {
   Jacobian jacobian;       ///< (6 x n) from the last jacobian call
   JointVector tau;         ///< (n x 1) result of inverseDynamics() [N m]
   JointVector qdd;         ///< (n x 1) result of forwardDynamics() [rad/s^2]
-  JointMatrix massMatrix;  ///< (n x n) from the last massMatrix() or forwardDynamics() [kg m^2]
+  JointMatrix massMatrix;  ///< (n x n) from the last massMatrix(), massMatrixAndBias() or forwardDynamics() [kg m^2]
+  JointVector bias;        ///< (n x 1) h(q, qd) of the last massMatrixAndBias() or forwardDynamics() [N m]
 
   /// For a model with mimic joints: the data of its full chain (ManipulatorModel::getChain()),
   /// where the algorithms compute before mapping back; its `linkTransforms` include the links
@@ -55,8 +56,7 @@ struct ManipulatorData {
   std::array<Vector<3>, kMaxJoints> massMoment;
   std::array<Matrix<3, 3>, kMaxJoints> originInertia;
   std::array<Eigen::Matrix<double, 6, 1>, kMaxJoints> biasForce, motionSubspace, inertiaTimesS;
-  JointVector bias;  // h(q, qd) of the last forwardDynamics()
-  JointMatrix ldl;   // massMatrix = L D L^T: L strictly below the diagonal (unit diagonal), D on it
+  JointMatrix ldl;  // massMatrix = L D L^T: L strictly below the diagonal (unit diagonal), D on it
   // Scratch of the articulated-body algorithm and of the Newton-Euler mass matrix.
   std::array<Eigen::Matrix<double, 6, 6>, kMaxJoints> articulatedInertia;
   std::array<Eigen::Matrix<double, 6, 1>, kMaxJoints> biasAcceleration;
