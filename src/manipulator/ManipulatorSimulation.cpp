@@ -133,7 +133,8 @@ std::unique_ptr<const ManipulatorModel> buildUnitPayload(const ManipulatorModel&
 
 // Solves A x = b for a symmetric positive definite A by Cholesky (A = L L^T), without allocation.
 // Each diagonal entry of L is inverted once: n divisions instead of n (n + 3) / 2 (a division
-// takes as long as a dozen multiplications in a row).
+// takes as long as a dozen multiplications in a row). b is read once, into x, after the
+// factorization: x may be b.
 void choleskySolve(const JointMatrix& A, const JointVector& b, JointMatrix& L, JointVector& x) {
   const auto n = static_cast<int>(A.rows());
   std::array<double, kMaxJoints> inverse;  // 1 / L(j, j) (each written before read)
@@ -236,7 +237,7 @@ bool solveContactMode(const JointMatrix& A, const JointVector& rhs, const JointV
 struct StepScratch {
   JointVector tauTotal, diag, rhs, residual, upper, lower, q0, v0, kq, kv, sumQ, sumV, payloadBias;
   JointVector start;  // the velocities the step starts from: their contact mode is tried first
-  JointMatrix A, L, payloadMass;
+  JointMatrix A, L;
   bool eulerSweeps = false;  // the friction sweeps start from the Euler step's v + h qdd0 (made on need)
 };
 thread_local internal::ThreadLocalSlot<StepScratch> tStepScratch;
@@ -343,9 +344,8 @@ void ManipulatorSimulation::dynamics(const JointVector& q, const JointVector& qd
   for (int i = 0; i < d.n; ++i) d.qdd(i) = s.payloadBias(i) - d.bias(i);
   d.massMatrix += stepMass_ * massMatrix(*u.model, *u.data, q);
   if (!solve) return;
-  s.payloadBias = d.qdd;
   s.L.resize(d.massMatrix.rows(), d.massMatrix.cols());
-  choleskySolve(d.massMatrix, s.payloadBias, s.L, d.qdd);
+  choleskySolve(d.massMatrix, d.qdd, s.L, d.qdd);
 }
 
 const JointVector& ManipulatorSimulation::getAcceleration() const {
