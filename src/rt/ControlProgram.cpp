@@ -26,6 +26,7 @@
 #include "../core/ShortNumber.hpp"
 #include "CycleSignal.hpp"
 #include "LogChannel.hpp"
+#include "Ticks.hpp"
 #include "rp/core/Configuration.hpp"
 #include "rp/core/ObjectManager.hpp"
 #include "rp/core/RoboticPlatform.hpp"
@@ -44,7 +45,6 @@ namespace rp {
 
 namespace internal {
 
-std::int64_t monotonicNanoseconds() noexcept;
 void ensureShutdownWatcher();
 
 namespace {
@@ -186,7 +186,7 @@ struct ControlProgram::Impl {
   bool joining = false;          // entered in the current cycle
   std::uint64_t startTick = 0;   // simulated clock: the first tick it may run
   std::uint64_t k = 0;           // cycles run in this run
-  std::int64_t cycleNs = 0;      // computation time in the current cycle
+  std::int64_t cycleTicks = 0;   // computation time in the current cycle [internal::ticks()]
   std::uint64_t nextTick = 0;    // simulated clock: the tick after the last one run (see firstSimulatedTick())
   std::uint64_t cycleLimit = 0;
   // Cycle state, read by other threads too.
@@ -650,21 +650,23 @@ struct ControlProgram::Executor {
   }
 
   // Loop threads: the three phases of programs first, first + stride, ... of l, each program's
-  // time charged to it (from `start` [ns] on). With a stride (a spread executor) the threads meet
-  // after each phase, so that every control() sees every program's inputs of this cycle and every
-  // write follows every control(). Returns when this thread's phases ended [ns] (with a stride,
-  // when every thread's have).
-  std::int64_t phases(List& l, std::size_t first, std::size_t stride, std::int64_t start) noexcept {
-    std::int64_t last = start;
+  // time charged to it in ticks (Ticks.hpp: a reading of the time-stamp counter between two
+  // programs, where a clock_gettime() cost as much as a tenth of a simulated arm's cycle). With a
+  // stride (a spread executor) the threads meet after each phase, so that every control() sees
+  // every program's inputs of this cycle and every write follows every control(); the wait at a
+  // meeting is charged to no program. Returns when this thread's phases ended [ns] (with a
+  // stride, when every thread's have).
+  std::int64_t phases(List& l, std::size_t first, std::size_t stride) noexcept {
+    std::int64_t last = internal::ticks();
     auto charge = [&](Impl* p) {
-      const std::int64_t now = internal::monotonicNanoseconds();
-      p->cycleNs += now - last;
+      const std::int64_t now = internal::ticks();
+      p->cycleTicks += now - last;
       last = now;
     };
     auto meet = [&] {
       if (stride == 1) return;
       barrier.wait();
-      last = internal::monotonicNanoseconds();
+      last = internal::ticks();
     };
     // Each phase: this thread's programs in their order, each one's time charged to it.
     auto each = [&](auto&& phase) {
@@ -678,7 +680,7 @@ struct ControlProgram::Executor {
     };
     // Phase 1: parameters and inputs.
     each([&](Impl& p) {
-      p.cycleNs = 0;
+      p.cycleTicks = 0;
       p.time.store(cycleClock, std::memory_order_relaxed);
       p.applyParameters();
       p.self.readInputs();
@@ -691,7 +693,7 @@ struct ControlProgram::Executor {
     each([](Impl& p) { p.self.writeOutputs(); });
     meet();
     internal::currentLoop = nullptr;
-    return last;
+    return internal::monotonicNanoseconds();
   }
 
   // A worker thread of a spread executor: sleeps until the loop's next deadline, takes the cycle
@@ -721,7 +723,7 @@ struct ControlProgram::Executor {
       }
       if (workersQuit.load(std::memory_order_relaxed)) break;
       seen = go.load(std::memory_order_acquire);
-      phases(*cycleList, w, spread.size(), internal::monotonicNanoseconds());
+      phases(*cycleList, w, spread.size());
     }
     internal::currentExecutor = nullptr;
   }
@@ -740,15 +742,14 @@ struct ControlProgram::Executor {
     workers.clear();
   }
 
-  // Loop: one cycle at clock time t (tick: the simulated clock's, woke: when the thread woke
-  // [ns], latencyNs: how late, or -1 on the simulated clock). Returns the number of programs
-  // still to step and sets `done` to the time the phases ended [ns].
+  // Loop: one cycle at clock time t (tick: the simulated clock's, latencyNs: how late the thread
+  // woke [ns], or -1 on the simulated clock). Returns the number of programs still to step.
   //
   // catchUp (simulated clock): a cycle of only the programs that joined after the executor had
   // run their first tick `tick` (a program started on a clock that has just run that tick, or
   // that was paused after it): they run that tick as they would have in a thread of their own.
-  std::size_t step(double t, std::uint64_t tick, std::int64_t woke, std::int64_t latencyNs, std::int64_t deadline,
-                   std::int64_t period, bool catchUp = false) noexcept {
+  std::size_t step(double t, std::uint64_t tick, std::int64_t latencyNs, std::int64_t deadline, std::int64_t period,
+                   bool catchUp = false) noexcept {
     const bool simulated = latencyNs < 0;
     std::size_t live = 0;
     List* l = acquire();
@@ -778,10 +779,9 @@ struct ControlProgram::Executor {
         cycleList = l;
         nextWake.store(deadline + period, std::memory_order_relaxed);
         go.fetch_add(1, std::memory_order_release);
-        phases(*l, 0, spread.size(), woke);
-        done = internal::monotonicNanoseconds();
+        done = phases(*l, 0, spread.size());
       } else {
-        done = phases(*l, 0, 1, woke);
+        done = phases(*l, 0, 1);
       }
       // The programs' state of this cycle is published (in their phases): threads that publish
       // each cycle's state (CycleSignal.hpp) go now, not after the bookkeeping below.
@@ -791,16 +791,17 @@ struct ControlProgram::Executor {
       const Impl* slowest = nullptr;
       std::int64_t skipped = 0;
       if (overrun) skipped = (done - deadline - period) / period + 1;
+      const double nsPerTick = internal::nanosecondsPerTick();
       for (Impl* p : *l) {
         if (!active(p)) continue;
         internal::currentLoop = p;
         p->finishCycle(t, p->k++);
-        p->computation.add(p->cycleNs);
+        p->computation.add(std::llround(static_cast<double>(p->cycleTicks) * nsPerTick));
         if (!simulated) p->latency.add(latencyNs);
         if (overrun) {
           p->overruns.fetch_add(1, std::memory_order_relaxed);
           p->missed.fetch_add(static_cast<std::uint64_t>(skipped), std::memory_order_relaxed);
-          if (slowest == nullptr || p->cycleNs > slowest->cycleNs) slowest = p;
+          if (slowest == nullptr || p->cycleTicks > slowest->cycleTicks) slowest = p;
         }
         if (simulated) {
           p->nextTick = tick + ticksPerCycle;
@@ -813,7 +814,7 @@ struct ControlProgram::Executor {
       }
       if (slowest != nullptr) {
         overrunProgram.store(slowest, std::memory_order_relaxed);
-        overrunNs.store(slowest->cycleNs, std::memory_order_relaxed);
+        overrunNs.store(std::llround(static_cast<double>(slowest->cycleTicks) * nsPerTick), std::memory_order_relaxed);
       }
       internal::currentLoop = nullptr;
     }
@@ -845,7 +846,7 @@ struct ControlProgram::Executor {
       }
       if (quit.load(std::memory_order_relaxed)) break;
       latency.add(woke - deadline);
-      const std::size_t live = step(static_cast<double>(deadline - epoch) * 1e-9, 0, woke, woke - deadline, deadline, period);
+      const std::size_t live = step(static_cast<double>(deadline - epoch) * 1e-9, 0, woke - deadline, deadline, period);
       const std::int64_t done = internal::monotonicNanoseconds();
       cycleTime.add(done - woke);
       cycles.fetch_add(1, std::memory_order_relaxed);
@@ -871,13 +872,13 @@ struct ControlProgram::Executor {
         if (ran) {
           // Programs that joined too late for the tick just run: they run it on their own.
           const std::uint64_t last = tick - ticksPerCycle;
-          step(clk.tickTime(last), last, internal::monotonicNanoseconds(), -1, 0, 0, true);
+          step(clk.tickTime(last), last, -1, 0, 0, true);
         }
         if (endIfIdle()) break;
         continue;
       }
       const std::int64_t start = internal::monotonicNanoseconds();
-      const std::size_t live = step(clk.tickTime(tick), tick, start, -1, 0, 0);
+      const std::size_t live = step(clk.tickTime(tick), tick, -1, 0, 0);
       cycleTime.add(internal::monotonicNanoseconds() - start);
       cycles.fetch_add(1, std::memory_order_relaxed);
       ran = true;

@@ -331,6 +331,10 @@ TEST(Executor, AnOverrunIsNamedAfterTheProgramThatTookTheTime) {
   EXPECT_GE(hog.getStatistics().overruns, 1u);
   EXPECT_GE(idle.getStatistics().overruns, 1u);  // every program of the executor missed the deadline
   EXPECT_GE(hog.getStatistics().computationTime.max, idle.getStatistics().computationTime.max);
+  // The busy wait alone is 20 periods (40,000 us) of the monotonic clock: the program's time in
+  // that cycle (timed in ticks, src/rt/Ticks.hpp, and converted) is at least that.
+  EXPECT_GE(seen.lastOverrunProgramTime, 0.999 * 20e6 / 500);
+  EXPECT_GE(hog.getStatistics().computationTime.max, 0.999 * 20e6 / 500);
 }
 
 

@@ -33,7 +33,7 @@ struct ControlStatistics {
   std::uint64_t overruns = 0;    ///< cycles that ended after the next deadline
   std::uint64_t missedCycles = 0;  ///< deadlines skipped because of overruns (cycles that never ran)
   LatencyStatistics wakeupLatency;    ///< how late the thread woke after each deadline (real clock)
-  LatencyStatistics computationTime;  ///< time spent in control() and the bookkeeping around it
+  LatencyStatistics computationTime;  ///< time of its read, control and write phases in each cycle
   std::uint64_t logSamples = 0;       ///< log samples taken
   std::uint64_t lostLogSamples = 0;   ///< log samples dropped because the ring buffer was full
   bool realTimeScheduling = false;    ///< the thread runs with SCHED_FIFO
