@@ -312,11 +312,15 @@ void ManipulatorSimulation::setPayload(double mass, const Vector<3>& centre) {
     index = p.count++;  // complete before the hand-over below publishes it
   }
   p.handover.store({mass, static_cast<double>(index)});
+  payloadsSet_.fetch_add(1, std::memory_order_release);  // after the store: a step that sees it loads it
 }
 
 void ManipulatorSimulation::takePayload() noexcept {
+  const std::uint64_t set = payloadsSet_.load(std::memory_order_acquire);
+  if (set == payloadsTaken_) return;  // nothing new since the last payload taken
   std::array<double, 2> v{};
   if (!payload_->handover.tryLoad(v)) return;  // being changed: the next step takes it
+  payloadsTaken_ = set;  // (the values are set's or a later call's: a later one is loaded again)
   stepCentre_ = static_cast<int>(v[1]);
   stepMass_ = stepCentre_ < 0 ? 0.0 : v[0];
 }

@@ -3,6 +3,8 @@
 /// The dynamic simulation of a manipulator's arm: what a manipulator in simulation mode drives.
 
 #include <array>
+#include <atomic>
+#include <cstdint>
 #include <memory>
 
 #include "rp/model/Dynamics.hpp"
@@ -276,6 +278,10 @@ class ManipulatorSimulation {
   DynamicsOptions options_;
   double stepMass_ = 0;      // the payload of the current step [kg]
   int stepCentre_ = -1;      // its unit model (index into Payload's), -1: none
+  // setPayload() calls published, and how many of them the steps have taken: a step looks at the
+  // hand-over (a cache line of its own, behind a pointer) only when the two differ.
+  std::atomic<std::uint64_t> payloadsSet_{0};
+  std::uint64_t payloadsTaken_ = 0;
   // Sensors: a ring of the last delay_ + 1 readings (slots 0..delay_); head_ is the newest. Without
   // a delay every step writes and reads slot 0.
   JointVector countsPerRadian_, encoderOffset_;
