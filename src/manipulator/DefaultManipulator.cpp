@@ -48,11 +48,13 @@ struct DefaultManipulator::WrenchBox {
   // Real-time safe: lock-free. Returns true with a new snapshot (the first `slots` slots) when a
   // write happened since the last read; gives up (keeping the old one) after a few torn reads.
   bool read(int slots) {
-    if (values.version() == lastRead) return false;
+    if (current()) return false;
     for (int attempt = 0; attempt < 8; ++attempt)
       if (values.tryLoad(snapshot, static_cast<std::size_t>(slots * kSlot), &lastRead)) return true;
     return false;
   }
+  // Whether the snapshot has every write so far.
+  bool current() const noexcept { return values.version() == lastRead; }
 };
 
 namespace {
@@ -636,7 +638,10 @@ void DefaultManipulator::setZeroGravityModeOff() {
   zeroGravity_.store(false);
 }
 
-void DefaultManipulator::applyExternalWrench(const Vector<6>& wrench) { wrench_->write(0, Vector<3>(), wrench); }
+void DefaultManipulator::applyExternalWrench(const Vector<6>& wrench) {
+  wrench_->write(0, Vector<3>(), wrench);
+  wrenchesSet_.fetch_add(1, std::memory_order_release);  // after the write: a cycle that sees it reads it
+}
 
 void DefaultManipulator::applyExternalWrench(int link, const Vector<3>& point, const Vector<6>& wrench) {
   const int n = initial_.n;
@@ -645,6 +650,7 @@ void DefaultManipulator::applyExternalWrench(int link, const Vector<3>& point, c
                             std::to_string(n));
   }
   wrench_->write(link, point, wrench);
+  wrenchesSet_.fetch_add(1, std::memory_order_release);
 }
 
 void DefaultManipulator::startShutdown() {
@@ -925,7 +931,11 @@ void DefaultManipulator::readInputs() {
         readTime_ = 1e-9 * static_cast<double>(lastSampleTime_ - real.epochNanoseconds());
     }
   } else {
-    if (wrench_->read(n + 1)) applyWrenches(n);
+    // (The count first: the box is read only after a write, and taken when it is current.)
+    if (const std::uint64_t set = wrenchesSet_.load(std::memory_order_acquire); set != wrenchesTaken_) {
+      if (wrench_->read(n + 1)) applyWrenches(n);
+      if (wrench_->current()) wrenchesTaken_ = set;
+    }
     q_ = sim_->getPosition();
     qd_ = sim_->getVelocity();
   }
@@ -1134,10 +1144,13 @@ void DefaultManipulator::gravityWithPayload() {
   // when an executor steps many arms), or the arm's own data with mimic joints.
   ManipulatorData& d = internal::workspaceOr(*model_, *data_);
   gravityTorque(*model_, d, q_, gravity_);
-  std::array<double, 4> v{};
-  if (payload_->handover.tryLoad(v)) {  // being changed: the next cycle takes it
-    payloadMass_ = v[0];
-    payloadCentre_ << v[1], v[2], v[3];
+  if (const std::uint64_t set = payloadsSet_.load(std::memory_order_acquire); set != payloadsTaken_) {
+    std::array<double, 4> v{};
+    if (payload_->handover.tryLoad(v)) {  // being changed: the next cycle takes it
+      payloadsTaken_ = set;  // (v is set's or a later call's: a later one is loaded again)
+      payloadMass_ = v[0];
+      payloadCentre_ << v[1], v[2], v[3];
+    }
   }
   if (payloadMass_ == 0) return;
   // The weight W = m g at the centre p: the torque that holds it is -J_p^T W, J_p's columns the
@@ -1163,6 +1176,7 @@ void DefaultManipulator::setPayload(double mass, const Vector<3>& centre) {
   payload_->mass = mass;
   payload_->centre = centre;
   payload_->handover.store({mass, centre(0), centre(1), centre(2)});
+  payloadsSet_.fetch_add(1, std::memory_order_release);
 }
 
 double DefaultManipulator::getPayloadMass() const {

@@ -354,6 +354,11 @@ class DefaultManipulator : public Manipulator, public ControlProgram {
   JointVector q_, qd_, tau_, gravity_, hold_;
   double payloadMass_ = 0;  // the payload the servo thread took last [kg]
   Vector<3> payloadCentre_ = Vector<3>::Zero();  // its centre in the end-effector frame [m]
+  // Writes published to the wrench and payload boxes (each behind a pointer: a cache miss a
+  // cycle to look at with hundreds of arms) and how many of them the servo thread has taken: the
+  // cycle reads a box only when its two counts differ.
+  std::atomic<std::uint64_t> wrenchesSet_{0}, payloadsSet_{0};
+  std::uint64_t wrenchesTaken_ = 0, payloadsTaken_ = 0;
   Setpoint setpoint_;
   bool power_ = false;
   double restTime_ = 0, shutdownStart_ = 0;
