@@ -972,8 +972,10 @@ void DefaultManipulator::control() {
   TrajectoryGenerator* generator = generator_.load(std::memory_order_acquire);
   const bool generatorChanges = generator != activeGenerator_;
   activeGenerator_ = generator;
-  // (The request is taken in every cycle: one left pending would move the hold a cycle later.)
-  const bool holdRequested = holdHere_.exchange(false, std::memory_order_acq_rel);
+  // (The request is taken in every cycle: one left pending would move the hold a cycle later. It
+  // is looked at first: the exchange, a full barrier on x86, only when there is one.)
+  const bool holdRequested =
+      holdHere_.load(std::memory_order_relaxed) && holdHere_.exchange(false, std::memory_order_acq_rel);
   if (!power_ || zeroG || controlChanges || generatorChanges || holdRequested) hold_ = q_;
   setpoint_.position = hold_;
   setpoint_.velocity.setZero();

@@ -373,9 +373,15 @@ struct ControlProgram::Impl {
         for (std::size_t i = 0; i < logSources.size(); ++i) slot[i + 1] = *logSources[i];
         channel->commitPush();
       }
-      logSamples.fetch_add(1, std::memory_order_relaxed);
+      bump(logSamples);
     }
-    cycles.fetch_add(1, std::memory_order_relaxed);
+    bump(cycles);
+  }
+  // The loop's thread is the counts' only writer while the program runs (start() resets them
+  // before): a load and a store, not a locked read-modify-write (a full barrier on x86, per
+  // program and cycle).
+  static void bump(std::atomic<std::uint64_t>& count) noexcept {
+    count.store(count.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   }
 
   // On the simulated clock time waits for every program, so a program may also wait for the log
