@@ -48,7 +48,15 @@
 //   cost N  cpu_us_per_arm_cycle C
 // What grows with N here is the memory the arms' cycles touch outgrowing the caches and the TLB.
 //
-// Usage: arms_per_core [--mode M] [--integrator I] [--criterion C] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]
+// --huge-pages: the heap in transparent 2 MB pages. The program runs itself again with glibc's
+// tunable GLIBC_TUNABLES=glibc.malloc.hugetlb=1 (glibc 2.35 or later; the kernel's
+// /sys/kernel/mm/transparent_hugepage/enabled must be `madvise` or `always`), the setting a
+// deployment with hundreds of arms would make: hundreds of arms' objects span thousands of 4 KB
+// pages, more than the data TLB holds (docs/realtime.md, "Hundreds of arms in 2 MB pages").
+// Each trial and cost line also gives heap_huge_mb, the process's anonymous memory in 2 MB pages
+// (/proc/self/smaps_rollup, AnonHugePages) at the end of its window: 0 without the setting.
+//
+// Usage: arms_per_core [--mode M] [--integrator I] [--criterion C] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T] [--huge-pages]
 #include <sched.h>
 #include <unistd.h>
 #include <sys/resource.h>
@@ -100,7 +108,20 @@ struct Trial {
   double cpuPerCycle = 0;  // process CPU time (user + system) per arm cycle in the window [us]
   bool realTime = false;
   bool errors = false;
+  long hugeMb = 0;  // anonymous memory in 2 MB pages at the end of the window [MB]
 };
+
+// The process's anonymous memory in transparent huge pages [MB] (0 if it cannot be read).
+long hugePagesMb() {
+  std::FILE* f = std::fopen("/proc/self/smaps_rollup", "r");
+  if (f == nullptr) return 0;
+  char line[256];
+  long kb = 0;
+  while (std::fgets(line, sizeof line, f) != nullptr)
+    if (std::sscanf(line, "AnonHugePages: %ld kB", &kb) == 1) break;
+  std::fclose(f);
+  return kb / 1024;
+}
 
 double cpuSeconds() {
   rusage u{};
@@ -130,6 +151,7 @@ Trial run(int n, double seconds) {
   const double cpu0 = cpuSeconds();
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
   const double cpu1 = cpuSeconds();
+  result.hugeMb = hugePagesMb();
   for (std::size_t i = 0; i < arms.size(); ++i) {
     const ControlStatistics s = arms[i]->getStatistics();
     result.overruns += s.overruns - overruns0[i];
@@ -155,9 +177,9 @@ Trial run(int n, double seconds) {
 void print(const Trial& t, double seconds) {
   const double expected = t.arms * seconds * 1000.0;
   std::printf("N %4d  overruns %6llu  cycles %.1f %%  cycle_p50_us %5.1f  cycle_p99_us %6.1f  wakeup_p99_us %7.1f  "
-              "wakeup_max_us %8.1f  exec_cycle_p99_us %7.1f  cpu_us_per_arm_cycle %5.2f%s\n",
+              "wakeup_max_us %8.1f  exec_cycle_p99_us %7.1f  cpu_us_per_arm_cycle %5.2f  heap_huge_mb %ld%s\n",
               t.arms, static_cast<unsigned long long>(t.overruns), 100.0 * static_cast<double>(t.cycles) / expected,
-              t.cycleP50, t.cycleP99, t.wakeupP99, t.wakeupMax, t.executorCycleP99, t.cpuPerCycle,
+              t.cycleP50, t.cycleP99, t.wakeupP99, t.wakeupMax, t.executorCycleP99, t.cpuPerCycle, t.hugeMb,
               t.errors ? "  (arm errors)" : "");
   std::fflush(stdout);
 }
@@ -188,7 +210,7 @@ Trial attempt(int n, double seconds, int tries) {
 
 int main(int argc, char** argv) {
   int cpu = 1, start = 16, max = 4096, resolution = 4, tries = 3;
-  bool maxGiven = false;
+  bool maxGiven = false, hugePages = false;
   double seconds = 5;
   std::string mode = "both", integrator = "rk4";
   for (int i = 1; i < argc; ++i) {
@@ -232,11 +254,22 @@ int main(int argc, char** argv) {
       tries = std::max(1, std::atoi(value()));
     } else if (a == "--resolution") {
       resolution = std::max(1, std::atoi(value()));
+    } else if (a == "--huge-pages") {
+      hugePages = true;
     } else {
       std::fprintf(stderr,
-                   "usage: arms_per_core [--mode shared|own|both|spread|cost] [--integrator rk4|euler] [--criterion strict|cpu] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T]\n");
+                   "usage: arms_per_core [--mode shared|own|both|spread|cost] [--integrator rk4|euler] [--criterion strict|cpu] [--cpu C] [--seconds S] [--start N] [--max N] [--resolution R] [--tries T] [--huge-pages]\n");
       return 2;
     }
+  }
+  // --huge-pages: glibc reads its tunables when the program starts, so the program starts again
+  // with the tunable added (once: the second run finds it set).
+  if (const char* t = std::getenv("GLIBC_TUNABLES"); hugePages && (t == nullptr || std::strstr(t, "glibc.malloc.hugetlb") == nullptr)) {
+    const std::string tunables = std::string(t != nullptr && *t != '\0' ? std::string(t) + ":" : "") + "glibc.malloc.hugetlb=1";
+    setenv("GLIBC_TUNABLES", tunables.c_str(), 1);
+    execv("/proc/self/exe", argv);
+    std::fprintf(stderr, "arms_per_core: cannot run again with GLIBC_TUNABLES=%s: %s\n", tunables.c_str(), std::strerror(errno));
+    return 1;
   }
   if (start < 1 || seconds <= 0) {
     std::fprintf(stderr, "arms_per_core: --start must be >= 1 and --seconds > 0\n");
@@ -270,7 +303,8 @@ int main(int argc, char** argv) {
                 integrator.c_str(), cpu, seconds);
     for (int n = start; n <= max; n *= 2) {
       const Trial t = run(n, seconds);
-      std::printf("cost %4d  cpu_us_per_arm_cycle %6.2f%s\n", n, t.cpuPerCycle, t.errors ? "  (arm errors)" : "");
+      std::printf("cost %4d  cpu_us_per_arm_cycle %6.2f  heap_huge_mb %ld%s\n", n, t.cpuPerCycle, t.hugeMb,
+                  t.errors ? "  (arm errors)" : "");
       std::fflush(stdout);
     }
     std::remove(config.c_str());
