@@ -45,7 +45,7 @@
 // --mode cost (not part of `both`): the CPU per arm-cycle as the count grows, without wake-ups or
 // deadlines: the arms on the simulated clock (one executor stepping them as fast as it can), each
 // count from --start doubling to --max (default 512) for --seconds, one line each
-//   cost N  cpu_us_per_arm_cycle C
+//   cost N  cpu_us_per_arm_cycle C  heap_huge_mb H
 // What grows with N here is the memory the arms' cycles touch outgrowing the caches and the TLB.
 //
 // --huge-pages: the heap in transparent 2 MB pages. The program runs itself again with glibc's
@@ -62,6 +62,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -265,7 +266,7 @@ int main(int argc, char** argv) {
   // --huge-pages: glibc reads its tunables when the program starts, so the program starts again
   // with the tunable added (once: the second run finds it set).
   if (const char* t = std::getenv("GLIBC_TUNABLES"); hugePages && (t == nullptr || std::strstr(t, "glibc.malloc.hugetlb") == nullptr)) {
-    const std::string tunables = std::string(t != nullptr && *t != '\0' ? std::string(t) + ":" : "") + "glibc.malloc.hugetlb=1";
+    const std::string tunables = (t != nullptr && *t != '\0' ? std::string(t) + ":" : std::string()) + "glibc.malloc.hugetlb=1";
     setenv("GLIBC_TUNABLES", tunables.c_str(), 1);
     execv("/proc/self/exe", argv);
     std::fprintf(stderr, "arms_per_core: cannot run again with GLIBC_TUNABLES=%s: %s\n", tunables.c_str(), std::strerror(errno));
