@@ -239,6 +239,15 @@ describe('rp-teachpendant', () => {
     assert.equal((await send('push', JSON.stringify({ force: [20, 0, 0] }))).pushing, true);
     const deadline = Date.now() + 20000;
     while ((await send('read', '')).pushing && Date.now() < deadline) await sleep(20);
+    // The page's frames may lag the program on a loaded machine, and a frame from before the
+    // push shows the arm at rest too (CI's ASan run once found the arm at rest 0.00007 rad from
+    // where it stood before the push; the Stop test above has seen such lag): the motion is
+    // awaited in the page first, then the rest after it. A push that never moves the arm still
+    // fails below, after the wait (checked with a push of 0.5 N: 'moved only 0 rad').
+    await waitInPage(ctx.page, (b) => {
+      const o = window.rp.frame.objects.find((x) => window.rp.scene.objects[x.index].name === 'puma');
+      return Math.sqrt(b.reduce((acc, x, k) => acc + (x - o.values[k]) ** 2, 0)) > 0.01;
+    }, before, 20000).catch(() => {});
     await atRest();
     const pushed = await joints();
     const moved = distance(before, pushed);
