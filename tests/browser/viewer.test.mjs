@@ -123,9 +123,15 @@ describe('Scene Viewer on work_cell', () => {
     const panel = ctx.page.locator('.panel[data-panel="puma"]');
     await panel.waitFor();
     const q = async () => panel.locator('.value[data-field="q"]').allTextContents();
+    // Live: the values change while the arm moves (it pauses between its motions, and the
+    // page's updates lag on a loaded machine: CI's ASan run once saw none in a fixed 500 ms), so
+    // the panel is read until they change, for up to 20 s.
     const a = await q();
-    await sleep(500);
-    const b = await q();
+    let b = a;
+    for (const until = Date.now() + 20000; Date.now() < until && JSON.stringify(b) === JSON.stringify(a);) {
+      await sleep(100);
+      b = await q();
+    }
     assert.equal(a.length, 6);
     assert.notDeepEqual(a, b, 'joint positions do not change');
     assert.equal(await panel.locator('.value[data-field="power"]').textContent(), 'on');
